@@ -1,0 +1,84 @@
+"""Errors of the package, each with a documented process exit code.
+
+Every error the package raises on purpose derives from :class:`RgbdEvalError`;
+third-party errors are re-raised as one of these with ``from err``. The CLI
+catches only these and prints ``str(err)`` as one line.
+
+Exit codes (also in README.md):
+
+====  =====================================================================
+0     success (scored, or nothing to score and the report says so)
+1     ``compare``: a metric regressed beyond its tolerance
+2     command-line usage error; ``compare``: unusable reports
+3     bad input recording (missing, truncated, wrong content)
+4     bad configuration (unknown key, wrong type, value out of range)
+5     bad ground truth (missing, unreadable, contradictory)
+6     the run could not be scored
+====  =====================================================================
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+
+class RgbdEvalError(Exception):
+    """Base class. ``exit_code`` is what the CLI exits with."""
+
+    exit_code: int = 1
+
+
+class InputError(RgbdEvalError):
+    """A recording cannot be read or does not hold what is expected."""
+
+    exit_code = 3
+
+    def __init__(self, path: Path | str, message: str, topic: str | None = None) -> None:
+        self.path = Path(path)
+        self.topic = topic
+        where = f"{self.path}" + (f" [{topic}]" if topic else "")
+        super().__init__(f"{where}: {message}")
+
+
+class TopicError(InputError):
+    """Topic detection failed (none, or several candidates)."""
+
+
+class DecodeError(InputError):
+    """A message could not be decoded (encoding, size, compression)."""
+
+
+class SyncError(InputError):
+    """Stamps cannot be synchronised (non-monotonic, nothing paired)."""
+
+
+class TransformError(InputError):
+    """The tf chain from the world frame to the camera is broken."""
+
+
+class ConfigError(RgbdEvalError):
+    """A configuration file or override is invalid."""
+
+    exit_code = 4
+
+
+class GroundTruthError(RgbdEvalError):
+    """Ground truth is missing, unreadable or contradictory."""
+
+    exit_code = 5
+
+    def __init__(self, path: Path | str, message: str) -> None:
+        self.path = Path(path)
+        super().__init__(f"{self.path}: {message}")
+
+
+class ScoringError(RgbdEvalError):
+    """A run could not be scored."""
+
+    exit_code = 6
+
+
+class CompareInputError(RgbdEvalError):
+    """Reports given to ``compare`` cannot be compared."""
+
+    exit_code = 2

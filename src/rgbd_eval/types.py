@@ -1,0 +1,301 @@
+"""The data model shared by every stage: frames -> detections -> tracks -> scores.
+
+Conventions (used everywhere in the package):
+
+- Stamps are integer nanoseconds.
+- Camera (optical) frames follow ROS REP-103: x right, y down, z forward.
+- The world frame (odometry ``odom``/``map``) is z-up; the ground plane is
+  spanned by world x and y. Without odometry, the world frame is the camera's
+  body frame at the camera (x forward, y left, z up), see :data:`OPTICAL_TO_BODY`.
+- Images: RGB is ``HxWx3 uint8`` in RGB channel order; depth is ``hxw float32``
+  in metres with NaN for invalid pixels.
+- 2D boxes are ``(left, top, width, height)`` in RGB image pixels.
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+FloatArray = NDArray[np.float64]
+
+
+class Visibility(enum.IntEnum):
+    """Visibility of a track, as in the thesis' Track message (seed 000, Listing 6.1)."""
+
+    VISIBLE = 0
+    OCCLUDED = 1
+    NOT_VISIBLE = 2
+
+
+class TrackStatus(enum.Enum):
+    """Life-cycle state of a track (seed 000, 6.4)."""
+
+    NEW = "new"
+    VALIDATED = "validated"
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+def _quat_to_matrix(q: tuple[float, float, float, float]) -> FloatArray:
+    x, y, z, w = q
+    n = x * x + y * y + z * z + w * w
+    if n < 1e-12:
+        raise ValueError(f"quaternion {q} has zero norm")
+    s = 2.0 / n
+    return np.array(
+        [
+            [1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+            [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+            [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)],
+        ]
+    )
+
+
+def _matrix_to_quat(R: FloatArray) -> tuple[float, float, float, float]:
+    """Rotation matrix -> unit quaternion (x, y, z, w), w >= 0 (Shepperd's method)."""
+    m = R
+    tr = float(m[0, 0] + m[1, 1] + m[2, 2])
+    if tr > 0:
+        s = np.sqrt(tr + 1.0) * 2
+        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+    elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
+        s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
+        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+    elif m[1, 1] > m[2, 2]:
+        s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
+        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
+    else:
+        s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
+        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+    q = np.array([x, y, z, w], dtype=float)
+    q /= np.linalg.norm(q)
+    if q[3] < 0:
+        q = -q
+    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+
+@dataclass(frozen=True)
+class Pose:
+    """A rigid transform ``parent_T_child``: maps points in the child frame to the parent frame.
+
+    ``rotation`` is a unit quaternion ``(x, y, z, w)`` as in ROS messages.
+    """
+
+    translation: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rotation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+
+    @staticmethod
+    def identity() -> Pose:
+        return Pose()
+
+    @staticmethod
+    def from_matrix(T: FloatArray) -> Pose:
+        """Build from a 4x4 homogeneous matrix."""
+        t = T[:3, 3]
+        return Pose((float(t[0]), float(t[1]), float(t[2])), _matrix_to_quat(T[:3, :3]))
+
+    def rotation_matrix(self) -> FloatArray:
+        return _quat_to_matrix(self.rotation)
+
+    def matrix(self) -> FloatArray:
+        """The 4x4 homogeneous matrix."""
+        T = np.eye(4)
+        T[:3, :3] = self.rotation_matrix()
+        T[:3, 3] = self.translation
+        return T
+
+    def compose(self, other: Pose) -> Pose:
+        """``self * other``: if self is a_T_b and other is b_T_c, the result is a_T_c."""
+        return Pose.from_matrix(self.matrix() @ other.matrix())
+
+    def inverse(self) -> Pose:
+        R = self.rotation_matrix()
+        t = np.asarray(self.translation)
+        T = np.eye(4)
+        T[:3, :3] = R.T
+        T[:3, 3] = -R.T @ t
+        return Pose.from_matrix(T)
+
+    def transform_points(self, points: FloatArray) -> FloatArray:
+        """Apply to an ``(N, 3)`` array of points."""
+        pts = np.asarray(points, dtype=np.float64)
+        return pts @ self.rotation_matrix().T + np.asarray(self.translation)
+
+
+#: body_T_optical for a camera: optical (x right, y down, z forward) -> body (x fwd, y left, z up).
+OPTICAL_TO_BODY = Pose((0.0, 0.0, 0.0), (-0.5, 0.5, -0.5, 0.5))
+
+
+@dataclass(frozen=True)
+class CameraModel:
+    """A pinhole camera (plumb-bob distortion kept for reference, images assumed rectified)."""
+
+    width: int
+    height: int
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    distortion: tuple[float, ...] = ()
+    frame_id: str = ""
+
+    def __post_init__(self) -> None:
+        if self.width <= 0 or self.height <= 0:
+            raise ValueError(f"camera size must be positive, got {self.width}x{self.height}")
+        if not (self.fx > 0 and self.fy > 0):
+            raise ValueError(f"focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+
+    @property
+    def K(self) -> FloatArray:
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def scaled(self, width: int, height: int) -> CameraModel:
+        """The same camera at another resolution (decimation or up-sampling)."""
+        sx, sy = width / self.width, height / self.height
+        return CameraModel(
+            width, height, self.fx * sx, self.fy * sy,
+            (self.cx + 0.5) * sx - 0.5, (self.cy + 0.5) * sy - 0.5,
+            self.distortion, self.frame_id,
+        )
+
+    def project(self, points: FloatArray) -> FloatArray:
+        """Project ``(N, 3)`` optical-frame points to ``(N, 2)`` pixel coordinates (u, v)."""
+        p = np.asarray(points, dtype=np.float64)
+        z = p[:, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            u = self.fx * p[:, 0] / z + self.cx
+            v = self.fy * p[:, 1] / z + self.cy
+        return np.stack([u, v], axis=1)
+
+    def rays(self) -> FloatArray:
+        """Unit-depth rays ``(H, W, 3)`` through every pixel centre (z = 1)."""
+        u = (np.arange(self.width, dtype=np.float64) - self.cx) / self.fx
+        v = (np.arange(self.height, dtype=np.float64) - self.cy) / self.fy
+        uu, vv = np.meshgrid(u, v)
+        return np.stack([uu, vv, np.ones_like(uu)], axis=-1)
+
+    def backproject(self, depth: NDArray[np.floating]) -> FloatArray:
+        """Depth image (metres, NaN invalid) -> ``(H, W, 3)`` optical-frame points (NaN invalid)."""
+        if depth.shape != (self.height, self.width):
+            raise ValueError(
+                f"depth image is {depth.shape[1]}x{depth.shape[0]}, camera is {self.width}x{self.height}"
+            )
+        return self.rays() * depth[..., None].astype(np.float64)
+
+
+@dataclass(frozen=True)
+class Box2D:
+    """An axis-aligned image box ``(left, top, width, height)`` in pixels."""
+
+    left: float
+    top: float
+    width: float
+    height: float
+
+    @property
+    def right(self) -> float:
+        return self.left + self.width
+
+    @property
+    def bottom(self) -> float:
+        return self.top + self.height
+
+    def as_tuple(self) -> tuple[float, float, float, float]:
+        return (self.left, self.top, self.width, self.height)
+
+
+@dataclass(frozen=True)
+class Box3D:
+    """An axis-aligned world box given by its minimum and maximum corners (metres)."""
+
+    min_corner: tuple[float, float, float]
+    max_corner: tuple[float, float, float]
+
+
+# ----------------------------------------------------------------------------- stream records
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One synchronised instant of a recording.
+
+    ``camera_pose`` is ``world_T_depth_optical``: it maps depth-camera optical-frame
+    points to the world frame. ``depth_to_rgb`` is ``rgb_optical_T_depth_optical``.
+    ``world_frame`` names the world frame; ``has_odometry`` is False when the
+    recording has no odometry and the world frame is the camera body frame.
+    """
+
+    index: int
+    stamp_ns: int
+    rgb: NDArray[np.uint8]
+    depth: NDArray[np.float32]
+    rgb_camera: CameraModel
+    depth_camera: CameraModel
+    depth_to_rgb: Pose = field(default_factory=Pose.identity)
+    camera_pose: Pose = field(default_factory=lambda: OPTICAL_TO_BODY)
+    world_frame: str = "camera"
+    has_odometry: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class Detection:
+    """One detected person candidate, in world coordinates (seed 000, 5.3, Listing 5.2).
+
+    ``position`` is the theoretical centroid (x, y, z) in the world frame; its x, y
+    are the ground-plane position used by trackers and metric gating.
+    ``appearance`` is a method-specific descriptor (e.g. a 3D colour histogram).
+    """
+
+    position: tuple[float, float, float]
+    height: float
+    confidence: float
+    box2d: Box2D
+    box3d: Box3D | None = None
+    distance: float = 0.0
+    occluded: bool = False
+    appearance: NDArray[np.float32] | None = None
+
+    @property
+    def ground_xy(self) -> tuple[float, float]:
+        return (self.position[0], self.position[1])
+
+
+@dataclass(frozen=True)
+class TrackOutput:
+    """A tracker's output for one track in one frame (seed 000, Listing 6.1)."""
+
+    track_id: int
+    x: float
+    y: float
+    height: float
+    box2d: Box2D | None
+    visibility: Visibility
+    status: TrackStatus = TrackStatus.VALIDATED
+
+
+@dataclass(frozen=True)
+class GroundTruthObject:
+    """One annotated person in one frame.
+
+    Either ``box2d`` (RGB image) or ``world_xyz`` (world frame) may be missing,
+    not both. ``visibility`` is the visible fraction in [0, 1]. ``ignore`` marks
+    people that are fully occluded or out of view: they neither count as a miss
+    nor make a false positive when a track sits on them.
+    """
+
+    frame: int
+    stamp_ns: int
+    object_id: int
+    box2d: Box2D | None
+    world_xyz: tuple[float, float, float] | None
+    visibility: float = 1.0
+    ignore: bool = False
+
+    def __post_init__(self) -> None:
+        if self.box2d is None and self.world_xyz is None:
+            raise ValueError(f"ground truth id {self.object_id} at frame {self.frame} has no box and no position")
