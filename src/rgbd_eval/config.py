@@ -74,6 +74,9 @@ class DetectorConfig(_Model):
     ground_plane: tuple[float, float, float, float] | None = Field(
         None, description="plane a, b, c, d in the depth optical frame, mode 'plane'"
     )
+    histogram_bins: int = Field(
+        8, ge=2, le=32, description="bins per channel of the blob's 3D colour histogram (6.2.2)"
+    )
     hog_default_confidence: float = Field(
         -100.0, description="confidence of clusters not visible top to bottom (5.4.2)"
     )
@@ -147,7 +150,6 @@ class TrackerConfig(_Model):
     selection_confidence: float = Field(
         -3.0, description="HOG threshold when selection is 'confidence' (7.3)"
     )
-    histogram_bins: int = Field(16, ge=2, le=64, description="bins per channel of the colour histogram")
     seed: int = Field(0, description="seed of the classifier's random features")
 
     @model_validator(mode="after")
