@@ -80,6 +80,53 @@ class DetectorConfig(_Model):
     hog_default_confidence: float = Field(
         -100.0, description="confidence of clusters not visible top to bottom (5.4.2)"
     )
+    ground_pixels: list[tuple[float, float]] | None = Field(
+        None,
+        description="three floor pixels (u, v) on the RGB image, mode 'points' "
+        "(the ground_detector's mouse clicks, 5.4.1)",
+    )
+    ground_max_tilt_deg: float = Field(
+        30.0,
+        gt=0.0,
+        lt=90.0,
+        description="largest angle between the floor normal and gravity (odometry up) accepted "
+        "by the automatic ground search; covers the Kinect's +-27 deg tilt (seed 000, 2.1)",
+    )
+    ground_min_points: int = Field(
+        30,
+        ge=3,
+        description="fewest floor voxels within one voxel of the plane needed to refine it; "
+        "with fewer the previous plane is kept (5.1, 5.4.2; as ~cluster/min_points, Table 5.1)",
+    )
+    subclustering: bool = Field(
+        True,
+        description="head-based sub-clustering of Munaro, Basso and Menegatti (IROS 2012), the "
+        "thesis authors' follow-up; off = the thesis' plain Euclidean clusters (5.2)",
+    )
+    min_head_distance: float = Field(
+        0.3,
+        gt=0.0,
+        description="smallest ground distance (m) between two heads and the distance below "
+        "which clusters are merged (Munaro et al. IROS 2012; 0.3 m in PCL's people module)",
+    )
+    min_head_prominence: float = Field(
+        0.1,
+        ge=0.0,
+        description="how far (m) a second head must rise above the lowest point between it and "
+        "a higher head; the head-to-shoulder drop of an adult is about 0.3 m",
+    )
+    surface_correction: bool = Field(
+        True,
+        description="move the head centroid from the visible surface to the head's axis "
+        "(4/3 of the across-view spread, exact for a sphere or upright cylinder); off = the "
+        "surface mean of 5.3",
+    )
+    hog_max_ground_gap: float = Field(
+        0.3,
+        gt=0.0,
+        description="a cluster is 'visible from top to bottom' (5.4.2), so HOG-scored, when its "
+        "lowest point is at most this high (m) and its full-body box is on the image",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> DetectorConfig:
@@ -91,10 +138,15 @@ class DetectorConfig(_Model):
             raise ValueError(
                 f"min_points={self.min_points} must not exceed max_points={self.max_points}"
             )
-        if self.ground_mode is GroundMode.POINTS and (
-            self.ground_points is None or len(self.ground_points) != 3
+        if self.ground_mode is GroundMode.POINTS and not (
+            (self.ground_points is not None and len(self.ground_points) == 3)
+            or (self.ground_pixels is not None and len(self.ground_pixels) == 3)
         ):
-            raise ValueError("ground_mode 'points' needs ground_points with exactly three points")
+            raise ValueError(
+                "ground_mode 'points' needs exactly three ground_points (3D) or ground_pixels "
+                f"(RGB image), got ground_points={self.ground_points}, "
+                f"ground_pixels={self.ground_pixels}"
+            )
         if self.ground_mode is GroundMode.PLANE and self.ground_plane is None:
             raise ValueError("ground_mode 'plane' needs ground_plane: [a, b, c, d]")
         return self
@@ -243,7 +295,9 @@ def _set_dotted(data: dict[str, Any], key: str, value: Any) -> None:
         if model is None or part not in fields:
             where = ".".join(parts[:i]) or "<root>"
             allowed = ", ".join(sorted(fields)) if model is not None else "none"
-            raise ConfigError(f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})")
+            raise ConfigError(
+                f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})"
+            )
         annotation = fields[part].annotation
         last = i == len(parts) - 1
         if last:
@@ -253,7 +307,11 @@ def _set_dotted(data: dict[str, Any], key: str, value: Any) -> None:
         if not isinstance(sub, dict):
             raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])} is not a section")
         node = sub
-        model = annotation if isinstance(annotation, type) and issubclass(annotation, BaseModel) else None
+        model = (
+            annotation
+            if isinstance(annotation, type) and issubclass(annotation, BaseModel)
+            else None
+        )
         fields = model.model_fields if model is not None else {}
 
 
@@ -263,7 +321,9 @@ def parse_overrides(items: Iterable[str]) -> list[tuple[str, Any]]:
     for item in items:
         key, sep, raw = item.partition("=")
         if not sep or not key.strip():
-            raise ConfigError(f"override {item!r}: expected KEY=VALUE, e.g. tracker.min_confidence=-1")
+            raise ConfigError(
+                f"override {item!r}: expected KEY=VALUE, e.g. tracker.min_confidence=-1"
+            )
         out.append((key.strip(), _parse_value(raw.strip())))
     return out
 

@@ -62,16 +62,36 @@ def _matrix_to_quat(R: FloatArray) -> tuple[float, float, float, float]:
     tr = float(m[0, 0] + m[1, 1] + m[2, 2])
     if tr > 0:
         s = np.sqrt(tr + 1.0) * 2
-        w, x, y, z = 0.25 * s, (m[2, 1] - m[1, 2]) / s, (m[0, 2] - m[2, 0]) / s, (m[1, 0] - m[0, 1]) / s
+        w, x, y, z = (
+            0.25 * s,
+            (m[2, 1] - m[1, 2]) / s,
+            (m[0, 2] - m[2, 0]) / s,
+            (m[1, 0] - m[0, 1]) / s,
+        )
     elif m[0, 0] > m[1, 1] and m[0, 0] > m[2, 2]:
         s = np.sqrt(1.0 + m[0, 0] - m[1, 1] - m[2, 2]) * 2
-        w, x, y, z = (m[2, 1] - m[1, 2]) / s, 0.25 * s, (m[0, 1] + m[1, 0]) / s, (m[0, 2] + m[2, 0]) / s
+        w, x, y, z = (
+            (m[2, 1] - m[1, 2]) / s,
+            0.25 * s,
+            (m[0, 1] + m[1, 0]) / s,
+            (m[0, 2] + m[2, 0]) / s,
+        )
     elif m[1, 1] > m[2, 2]:
         s = np.sqrt(1.0 + m[1, 1] - m[0, 0] - m[2, 2]) * 2
-        w, x, y, z = (m[0, 2] - m[2, 0]) / s, (m[0, 1] + m[1, 0]) / s, 0.25 * s, (m[1, 2] + m[2, 1]) / s
+        w, x, y, z = (
+            (m[0, 2] - m[2, 0]) / s,
+            (m[0, 1] + m[1, 0]) / s,
+            0.25 * s,
+            (m[1, 2] + m[2, 1]) / s,
+        )
     else:
         s = np.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1]) * 2
-        w, x, y, z = (m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s
+        w, x, y, z = (
+            (m[1, 0] - m[0, 1]) / s,
+            (m[0, 2] + m[2, 0]) / s,
+            (m[1, 2] + m[2, 1]) / s,
+            0.25 * s,
+        )
     q = np.array([x, y, z, w], dtype=float)
     q /= np.linalg.norm(q)
     if q[3] < 0:
@@ -124,7 +144,8 @@ class Pose:
     def transform_points(self, points: FloatArray) -> FloatArray:
         """Apply to an ``(N, 3)`` array of points."""
         pts = np.asarray(points, dtype=np.float64)
-        return pts @ self.rotation_matrix().T + np.asarray(self.translation)
+        out: FloatArray = pts @ self.rotation_matrix().T + np.asarray(self.translation)
+        return out
 
 
 #: body_T_optical for a camera: optical (x right, y down, z forward) -> body (x fwd, y left, z up).
@@ -151,16 +172,21 @@ class CameraModel:
             raise ValueError(f"focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
 
     @property
-    def K(self) -> FloatArray:
+    def K(self) -> FloatArray:  # noqa: N802 - the textbook name of the intrinsic matrix
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
 
     def scaled(self, width: int, height: int) -> CameraModel:
         """The same camera at another resolution (decimation or up-sampling)."""
         sx, sy = width / self.width, height / self.height
         return CameraModel(
-            width, height, self.fx * sx, self.fy * sy,
-            (self.cx + 0.5) * sx - 0.5, (self.cy + 0.5) * sy - 0.5,
-            self.distortion, self.frame_id,
+            width,
+            height,
+            self.fx * sx,
+            self.fy * sy,
+            (self.cx + 0.5) * sx - 0.5,
+            (self.cy + 0.5) * sy - 0.5,
+            self.distortion,
+            self.frame_id,
         )
 
     def project(self, points: FloatArray) -> FloatArray:
@@ -298,4 +324,6 @@ class GroundTruthObject:
 
     def __post_init__(self) -> None:
         if self.box2d is None and self.world_xyz is None:
-            raise ValueError(f"ground truth id {self.object_id} at frame {self.frame} has no box and no position")
+            raise ValueError(
+                f"ground truth id {self.object_id} at frame {self.frame} has no box and no position"
+            )

@@ -1,0 +1,50 @@
+# Two commands do all set-up on a fresh Debian machine:
+#   make run    - installs everything, generates the demo recording, runs the default method on it
+#   make test   - installs everything, runs the whole test suite (slow tests included)
+PYTHON ?= python3
+VENV   := .venv
+BIN    := $(VENV)/bin
+STAMP  := $(VENV)/.installed
+DEMO   := datasets/demo.mcap
+
+.PHONY: setup system-deps run test test-fast lint datasets bench clean
+
+# open3d needs the system library libusb-1.0 to import on a bare Debian machine.
+system-deps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libusb-1.0.so.0'; then \
+		echo "installing libusb-1.0 (needed by open3d)"; \
+		SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq libusb-1.0-0 >/dev/null; \
+	fi
+
+$(STAMP): pyproject.toml
+	@$(MAKE) --no-print-directory system-deps
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e ".[dev]"
+	@touch $(STAMP)
+
+setup: $(STAMP)
+
+$(DEMO): $(STAMP) configs/scenarios/demo.yaml
+	$(BIN)/rgbd-eval synth configs/scenarios/demo.yaml -o $(DEMO)
+
+datasets: $(STAMP)
+	$(BIN)/rgbd-eval synth --all
+
+run: $(STAMP) $(DEMO)
+	$(BIN)/rgbd-eval run $(DEMO)
+
+test: $(STAMP)
+	$(BIN)/python -m pytest -q
+
+test-fast: $(STAMP)
+	$(BIN)/python -m pytest -q -m "not slow"
+
+lint: $(STAMP)
+	$(BIN)/ruff check src tests
+	$(BIN)/ruff format --check src tests
+	$(BIN)/mypy
+
+clean:
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache runs .cache

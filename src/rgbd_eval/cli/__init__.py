@@ -1,0 +1,1 @@
+"""The ``rgbd-eval`` command line (typer); one module per command."""

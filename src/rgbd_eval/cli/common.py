@@ -1,0 +1,55 @@
+"""Shared CLI plumbing: error mapping, output console, option types."""
+
+from __future__ import annotations
+
+import functools
+import sys
+from collections.abc import Callable
+from typing import Any, ParamSpec, TypeVar
+
+import typer
+from rich.console import Console
+
+from rgbd_eval.errors import RgbdEvalError
+
+P = ParamSpec("P")
+R = TypeVar("R")
+
+#: Piped output is not cut at 80 columns: tables keep their topic names whole.
+console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
+err_console = Console(stderr=True, highlight=False)
+
+SCHEMA_VERSION = 1
+
+
+def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
+    """Turn the package's errors into one ``error:`` line on stderr and their exit code."""
+
+    @functools.wraps(func)
+    def wrapper(*args: P.args, **kwargs: P.kwargs) -> R:
+        try:
+            return func(*args, **kwargs)
+        except RgbdEvalError as err:
+            message = " ".join(str(err).split())
+            typer.echo(f"error: {message}", err=True)
+            raise typer.Exit(err.exit_code) from None
+
+    return wrapper
+
+
+def jsonable(value: Any) -> Any:
+    """Dataclasses, tuples and enums -> plain JSON values."""
+    import dataclasses
+    import enum
+
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {str(k): jsonable(v) for k, v in value.items()}
+    if isinstance(value, list | tuple | set):
+        return [jsonable(v) for v in value]
+    if isinstance(value, enum.Enum):
+        return value.value
+    if isinstance(value, float) and value != value:  # NaN
+        return None
+    return value

@@ -1,0 +1,37 @@
+"""The ``rgbd-eval`` application."""
+
+from __future__ import annotations
+
+import typer
+
+from rgbd_eval import __version__
+from rgbd_eval.cli.inspect_cmd import inspect
+
+app = typer.Typer(
+    name="rgbd-eval",
+    help="Batch evaluation of RGB-D people trackers on recorded robot data.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+app.command("inspect")(inspect)
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"rgbd-eval {__version__}")
+        raise typer.Exit(0)
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="print the version"
+    ),
+) -> None:
+    """Batch evaluation of RGB-D people trackers on recorded robot data."""
+
+
+def main() -> None:
+    """Console-script entry point."""
+    app()

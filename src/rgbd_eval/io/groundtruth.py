@@ -1,0 +1,313 @@
+"""Ground-truth formats: the sidecar CSV, the KTP text formats, and the ground-truth topic.
+
+Sidecar CSV (MOTChallenge style, extended with world coordinates)::
+
+    frame,stamp_ns,id,bb_left,bb_top,bb_width,bb_height,x,y,z,visibility,ignore
+
+Empty box fields mean "no box", empty x/y/z mean "no world position"; ``ignore``
+is 0/1 and may be omitted (then 0).
+
+KTP text (Kinect Tracking Precision dataset), one line per frame::
+
+    <stamp seconds>: id x y w h, id x y w h, ...     (2D boxes)
+    <stamp seconds>: id x y z, id x y z, ...         (3D positions; 0 0 0 = missing)
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from rgbd_eval.errors import GroundTruthError
+from rgbd_eval.types import Box2D, GroundTruthObject
+
+CSV_COLUMNS = (
+    "frame",
+    "stamp_ns",
+    "id",
+    "bb_left",
+    "bb_top",
+    "bb_width",
+    "bb_height",
+    "x",
+    "y",
+    "z",
+    "visibility",
+    "ignore",
+)
+_REQUIRED = CSV_COLUMNS[:11]
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """Annotations of one sequence, grouped by frame (sorted by stamp, then frame)."""
+
+    source: str
+    frames: tuple[tuple[int, int, tuple[GroundTruthObject, ...]], ...]
+    """Per annotated frame: (frame index, stamp_ns, objects)."""
+
+    @property
+    def num_objects(self) -> int:
+        return sum(len(objs) for _, _, objs in self.frames)
+
+    @property
+    def ids(self) -> set[int]:
+        return {o.object_id for _, _, objs in self.frames for o in objs}
+
+    @property
+    def has_boxes(self) -> bool:
+        return any(o.box2d is not None for _, _, objs in self.frames for o in objs)
+
+    @property
+    def has_world(self) -> bool:
+        return any(o.world_xyz is not None for _, _, objs in self.frames for o in objs)
+
+    def align(
+        self, stamps_ns: Sequence[int], max_gap_ns: int
+    ) -> tuple[list[list[GroundTruthObject]], int]:
+        """Annotations per recording frame, matched by nearest stamp within ``max_gap_ns``.
+
+        When the annotations carry no stamps (all 0) they are matched by frame index.
+        Returns the per-frame lists and the number of annotated frames left unmatched.
+        """
+        out: list[list[GroundTruthObject]] = [[] for _ in stamps_ns]
+        if not self.frames:
+            return out, 0
+        unmatched = 0
+        if all(stamp == 0 for _, stamp, _ in self.frames):
+            for index, _, objs in self.frames:
+                if 0 <= index < len(out):
+                    out[index] = list(objs)
+                else:
+                    unmatched += 1
+            return out, unmatched
+        rec = np.asarray(stamps_ns, dtype=np.int64)
+        taken: set[int] = set()
+        for _, stamp, objs in self.frames:
+            if rec.size == 0:
+                unmatched += 1
+                continue
+            j = int(np.searchsorted(rec, stamp))
+            cands = [k for k in (j - 1, j) if 0 <= k < rec.size]
+            k = min(cands, key=lambda c: abs(int(rec[c]) - stamp))
+            if abs(int(rec[k]) - stamp) <= max_gap_ns and k not in taken:
+                out[k] = list(objs)
+                taken.add(k)
+            else:
+                unmatched += 1
+        return out, unmatched
+
+
+def _group(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
+    """Group objects by frame, rejecting contradictions."""
+    by_frame: dict[int, list[GroundTruthObject]] = {}
+    stamps: dict[int, int] = {}
+    for o in objects:
+        if o.frame in stamps and stamps[o.frame] != o.stamp_ns:
+            raise GroundTruthError(
+                source, f"frame {o.frame} has two stamps ({stamps[o.frame]} and {o.stamp_ns})"
+            )
+        stamps[o.frame] = o.stamp_ns
+        group = by_frame.setdefault(o.frame, [])
+        if any(p.object_id == o.object_id for p in group):
+            raise GroundTruthError(source, f"id {o.object_id} appears twice in frame {o.frame}")
+        group.append(o)
+    order = sorted(by_frame, key=lambda f: (stamps[f], f))
+    prev = -1
+    for f in order:
+        if stamps[f] != 0 and stamps[f] == prev:
+            raise GroundTruthError(source, f"two frames share stamp {stamps[f]}")
+        prev = stamps[f]
+    return GroundTruth(source, tuple((f, stamps[f], tuple(by_frame[f])) for f in order))
+
+
+# ----------------------------------------------------------------------------- CSV
+
+
+def _opt_float(value: str) -> float | None:
+    value = value.strip()
+    if value == "" or value.lower() == "nan":
+        return None
+    return float(value)
+
+
+def read_csv(path: Path) -> GroundTruth:
+    """Read the sidecar CSV; any malformed line is a :class:`GroundTruthError` naming it."""
+    path = Path(path)
+    try:
+        handle = path.open(newline="", encoding="utf-8")
+    except OSError as err:
+        raise GroundTruthError(path, f"cannot read ground truth ({err.strerror})") from err
+    objects = []
+    with handle:
+        reader = csv.DictReader(handle)
+        missing = [c for c in _REQUIRED if c not in (reader.fieldnames or [])]
+        if missing:
+            raise GroundTruthError(
+                path, f"missing columns {', '.join(missing)}; expected {','.join(CSV_COLUMNS)}"
+            )
+        for row in reader:
+            line = reader.line_num
+            try:
+                box_vals = [
+                    _opt_float(row[c]) for c in ("bb_left", "bb_top", "bb_width", "bb_height")
+                ]
+                xyz = [_opt_float(row[c]) for c in ("x", "y", "z")]
+                box = None
+                if all(v is not None for v in box_vals):
+                    left, top, width, height = (float(v) for v in box_vals if v is not None)
+                    if width < 0 or height < 0:
+                        raise ValueError(f"negative box size {width}x{height}")
+                    box = Box2D(left, top, width, height) if width > 0 and height > 0 else None
+                world = None
+                if all(v is not None for v in xyz):
+                    world = (float(xyz[0] or 0.0), float(xyz[1] or 0.0), float(xyz[2] or 0.0))
+                visibility = float(row["visibility"]) if row["visibility"].strip() else 1.0
+                if not 0.0 <= visibility <= 1.0:
+                    raise ValueError(f"visibility {visibility} outside [0, 1]")
+                ignore_text = (row.get("ignore") or "0").strip()
+                objects.append(
+                    GroundTruthObject(
+                        frame=int(row["frame"]),
+                        stamp_ns=int(row["stamp_ns"] or 0),
+                        object_id=int(row["id"]),
+                        box2d=box,
+                        world_xyz=world,
+                        visibility=visibility,
+                        ignore=ignore_text not in ("", "0", "false", "False"),
+                    )
+                )
+            except (ValueError, TypeError) as err:
+                raise GroundTruthError(path, f"line {line}: {err}") from err
+    return _group(str(path), objects)
+
+
+def _fmt(value: float | None) -> str:
+    if value is None or (isinstance(value, float) and math.isnan(value)):
+        return ""
+    return repr(float(value))
+
+
+def write_csv(path: Path, objects: Iterable[GroundTruthObject]) -> None:
+    """Write the sidecar CSV atomically (temp file, then rename)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    with tmp.open("w", newline="", encoding="utf-8") as handle:
+        writer = csv.writer(handle)
+        writer.writerow(CSV_COLUMNS)
+        for o in objects:
+            box: tuple[float | None, ...] = o.box2d.as_tuple() if o.box2d else (None,) * 4
+            xyz: tuple[float | None, ...] = o.world_xyz if o.world_xyz else (None,) * 3
+            writer.writerow(
+                [
+                    o.frame,
+                    o.stamp_ns,
+                    o.object_id,
+                    *(_fmt(v) for v in box),
+                    *(_fmt(v) for v in xyz),
+                    _fmt(o.visibility),
+                    int(o.ignore),
+                ]
+            )
+    os.replace(tmp, path)
+
+
+# ----------------------------------------------------------------------------- KTP
+
+
+def _stamp_ns(text: str) -> int:
+    return int(Decimal(text.strip()) * 1_000_000_000)
+
+
+def read_ktp(path: Path) -> GroundTruth:
+    """Read a KTP ground-truth text file (2D boxes or 3D positions, detected per file)."""
+    path = Path(path)
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as err:
+        raise GroundTruthError(path, f"cannot read ground truth ({err.strerror})") from err
+    objects = []
+    arity: int | None = None
+    frame = -1
+    for number, line in enumerate(lines, start=1):
+        if not line.strip() or line.lstrip().startswith("#"):
+            continue
+        head, sep, rest = line.partition(":")
+        if not sep:
+            raise GroundTruthError(path, f"line {number}: expected '<stamp>: id ...'")
+        try:
+            stamp = _stamp_ns(head)
+        except InvalidOperation as err:
+            raise GroundTruthError(path, f"line {number}: bad stamp {head.strip()!r}") from err
+        frame += 1
+        for entry in filter(None, (e.strip() for e in rest.split(","))):
+            values = entry.split()
+            if len(values) not in (4, 5):
+                raise GroundTruthError(
+                    path,
+                    f"line {number}: entry {entry!r} needs 'id x y w h' (2D) or 'id x y z' (3D)",
+                )
+            if arity is None:
+                arity = len(values)
+            elif arity != len(values):
+                raise GroundTruthError(path, f"line {number}: mixes 2D and 3D entries")
+            try:
+                oid = int(values[0])
+                nums = [float(v) for v in values[1:]]
+            except ValueError as err:
+                raise GroundTruthError(path, f"line {number}: {err}") from err
+            if all(v == 0.0 for v in nums):
+                continue  # 0 0 0 (0) means the person is not annotated in this frame
+            if arity == 5:
+                obj = GroundTruthObject(frame, stamp, oid, Box2D(*nums), None)
+            else:
+                obj = GroundTruthObject(frame, stamp, oid, None, (nums[0], nums[1], nums[2]))
+            objects.append(obj)
+    return _group(str(path), objects)
+
+
+# ----------------------------------------------------------------------------- topic
+
+
+def objects_from_message(msg: Any, frame: int, stamp_ns: int) -> list[GroundTruthObject]:
+    """Objects of one ``rgbd_eval_msgs/GroundTruthArray`` message."""
+    out = []
+    for p in msg.people:
+        box = (
+            Box2D(p.bb_left, p.bb_top, p.bb_width, p.bb_height)
+            if p.bb_width > 0 and p.bb_height > 0
+            else None
+        )
+        world = None if math.isnan(p.x) else (float(p.x), float(p.y), float(p.z))
+        if box is None and world is None:
+            continue
+        out.append(
+            GroundTruthObject(
+                frame, stamp_ns, int(p.id), box, world, float(p.visibility), bool(p.ignore)
+            )
+        )
+    return out
+
+
+def from_objects(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
+    """Group already decoded objects (e.g. from the ground-truth topic)."""
+    return _group(source, objects)
+
+
+def load_ground_truth(path: Path) -> GroundTruth:
+    """Load a sidecar CSV (``.csv``) or a KTP text file (anything else)."""
+    path = Path(path)
+    if not path.exists():
+        raise GroundTruthError(path, "ground-truth file not found")
+    if path.suffix.lower() == ".csv":
+        return read_csv(path)
+    return read_ktp(path)

@@ -1,0 +1,146 @@
+"""A small tf buffer: static and time-stamped transforms, chains, interpolation (lerp + slerp)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from itertools import pairwise
+
+import numpy as np
+
+from rgbd_eval.types import FloatArray, Pose
+
+
+def slerp(q0: FloatArray, q1: FloatArray, t: float) -> FloatArray:
+    """Spherical linear interpolation between unit quaternions ``(x, y, z, w)``."""
+    q0 = q0 / np.linalg.norm(q0)
+    q1 = q1 / np.linalg.norm(q1)
+    dot = float(np.dot(q0, q1))
+    if dot < 0.0:  # take the short way round
+        q1, dot = -q1, -dot
+    if dot > 0.9995:  # nearly parallel: lerp is exact enough and stable
+        q = q0 + t * (q1 - q0)
+        lerped: FloatArray = q / np.linalg.norm(q)
+        return lerped
+    theta = np.arccos(dot)
+    out: FloatArray = (np.sin((1.0 - t) * theta) * q0 + np.sin(t * theta) * q1) / np.sin(theta)
+    return out
+
+
+@dataclass
+class _Edge:
+    parent: str
+    static: bool
+    stamps: list[int] = field(default_factory=list)
+    translations: list[tuple[float, float, float]] = field(default_factory=list)
+    rotations: list[tuple[float, float, float, float]] = field(default_factory=list)
+    _arrays: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        if self._arrays is None:
+            order = np.argsort(np.asarray(self.stamps, dtype=np.int64), kind="stable")
+            self._arrays = (
+                np.asarray(self.stamps, dtype=np.int64)[order],
+                np.asarray(self.translations, dtype=np.float64)[order],
+                np.asarray(self.rotations, dtype=np.float64)[order],
+            )
+        return self._arrays
+
+
+class TransformLookupError(ValueError):
+    """Frames are not connected, or a stamp is outside the recorded transforms."""
+
+
+class TfBuffer:
+    """Transforms ``parent_T_child`` keyed by child frame (a tf tree: one parent per child)."""
+
+    def __init__(self) -> None:
+        self._edges: dict[str, _Edge] = {}
+
+    def add(self, parent: str, child: str, stamp_ns: int, pose: Pose, static: bool = False) -> None:
+        parent, child = parent.lstrip("/"), child.lstrip("/")
+        edge = self._edges.get(child)
+        if edge is None:
+            edge = self._edges[child] = _Edge(parent, static)
+        elif edge.parent != parent:
+            raise TransformLookupError(
+                f"frame {child!r} has two parents: {edge.parent!r} and {parent!r}"
+            )
+        if static:
+            edge.static = True
+            edge.stamps, edge.translations, edge.rotations = (
+                [stamp_ns],
+                [pose.translation],
+                [pose.rotation],
+            )
+        else:
+            edge.stamps.append(stamp_ns)
+            edge.translations.append(pose.translation)
+            edge.rotations.append(pose.rotation)
+        edge._arrays = None
+
+    @property
+    def frames(self) -> set[str]:
+        return set(self._edges) | {e.parent for e in self._edges.values()}
+
+    @property
+    def has_dynamic(self) -> bool:
+        return any(not e.static for e in self._edges.values())
+
+    def _path_to_root(self, frame: str) -> list[str]:
+        path = [frame]
+        while path[-1] in self._edges:
+            parent = self._edges[path[-1]].parent
+            if parent in path:
+                raise TransformLookupError(f"tf loop through {parent!r}")
+            path.append(parent)
+        return path
+
+    def chain(self, target: str, source: str) -> list[str]:
+        """Frames from ``target`` to ``source`` through their common ancestor."""
+        target, source = target.lstrip("/"), source.lstrip("/")
+        up_source = self._path_to_root(source)
+        up_target = self._path_to_root(target)
+        common = next((f for f in up_source if f in up_target), None)
+        if common is None:
+            known = ", ".join(sorted(self.frames)) or "none"
+            raise TransformLookupError(
+                f"no tf chain from {target!r} to {source!r} (root of {target!r} is "
+                f"{up_target[-1]!r}, root of {source!r} is {up_source[-1]!r}; frames: {known})"
+            )
+        down = up_target[: up_target.index(common) + 1]
+        up = up_source[: up_source.index(common)]
+        return down + list(reversed(up))
+
+    def _edge_pose(self, child: str, stamp_ns: int, tolerance_ns: int) -> Pose:
+        edge = self._edges[child]
+        stamps, trans, rots = edge.arrays()
+        if edge.static or (len(stamps) == 1 and abs(int(stamps[0]) - stamp_ns) <= tolerance_ns):
+            return Pose(tuple(trans[0]), tuple(rots[0]))
+        i = int(np.searchsorted(stamps, stamp_ns, side="right"))
+        if i == 0 or i == len(stamps):
+            k = 0 if i == 0 else len(stamps) - 1
+            if abs(int(stamps[k]) - stamp_ns) > tolerance_ns:
+                raise TransformLookupError(
+                    f"{edge.parent}->{child} has no transform at {stamp_ns} ns "
+                    f"(recorded {int(stamps[0])}..{int(stamps[-1])})"
+                )
+            return Pose(tuple(trans[k]), tuple(rots[k]))
+        t0, t1 = int(stamps[i - 1]), int(stamps[i])
+        a = 0.0 if t1 == t0 else (stamp_ns - t0) / (t1 - t0)
+        p = trans[i - 1] + a * (trans[i] - trans[i - 1])
+        q = slerp(rots[i - 1], rots[i], a)
+        return Pose(
+            (float(p[0]), float(p[1]), float(p[2])),
+            (float(q[0]), float(q[1]), float(q[2]), float(q[3])),
+        )
+
+    def lookup(self, target: str, source: str, stamp_ns: int, tolerance_ns: int = 0) -> Pose:
+        """``target_T_source`` at ``stamp_ns``, interpolated; held up to ``tolerance_ns`` past the ends."""
+        frames = self.chain(target, source)
+        T = np.eye(4)
+        for parent, child in pairwise(frames):
+            if self._edges.get(child) is not None and self._edges[child].parent == parent:
+                T = T @ self._edge_pose(child, stamp_ns, tolerance_ns).matrix()
+            else:
+                T = T @ self._edge_pose(parent, stamp_ns, tolerance_ns).inverse().matrix()
+        return Pose.from_matrix(T)
