@@ -290,29 +290,22 @@ def _set_dotted(data: dict[str, Any], key: str, value: Any) -> None:
         raise ConfigError(f"override {key!r}: empty key segment")
     fields: Mapping[str, Any] = RunConfig.model_fields
     node = data
-    model: type[BaseModel] | None = RunConfig
     for i, part in enumerate(parts):
-        if model is None or part not in fields:
-            where = ".".join(parts[:i]) or "<root>"
-            allowed = ", ".join(sorted(fields)) if model is not None else "none"
-            raise ConfigError(
-                f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})"
-            )
-        annotation = fields[part].annotation
-        last = i == len(parts) - 1
-        if last:
+        where = ".".join(parts[:i]) or "<root>"
+        if part not in fields:
+            allowed = ", ".join(sorted(fields))
+            raise ConfigError(f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})")
+        if i == len(parts) - 1:
             node[part] = value
             return
+        annotation = fields[part].annotation
+        if not (isinstance(annotation, type) and issubclass(annotation, BaseModel)):
+            raise ConfigError(f"override {key!r}: {where}.{part} is not a section".replace("<root>.", ""))
         sub = node.setdefault(part, {})
         if not isinstance(sub, dict):
             raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])} is not a section")
         node = sub
-        model = (
-            annotation
-            if isinstance(annotation, type) and issubclass(annotation, BaseModel)
-            else None
-        )
-        fields = model.model_fields if model is not None else {}
+        fields = annotation.model_fields
 
 
 def parse_overrides(items: Iterable[str]) -> list[tuple[str, Any]]:

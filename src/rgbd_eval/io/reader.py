@@ -1,8 +1,8 @@
 """Open a recording and stream synchronised :class:`~rgbd_eval.types.Frame` objects.
 
 Supported containers: ROS1 ``.bag`` (v2.0; none/lz4/bz2 chunks), ROS2 bag folders
-(sqlite3 or mcap storage), lone ``.mcap`` / ``.db3`` files, all through
-``rosbags.highlevel.AnyReader``.
+(sqlite3 or mcap storage), lone ``.mcap`` / ``.db3`` files, through
+:mod:`rgbd_eval.io.source` (``mcap.reader`` for lone .mcap, rosbags' AnyReader otherwise).
 
 Reading takes two passes, so memory stays flat in the sequence length:
 
@@ -25,10 +25,6 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
-from rosbags.highlevel import AnyReader, AnyReaderError
-from rosbags.rosbag1 import ReaderError as Ros1ReaderError
-from rosbags.rosbag2 import ReaderError as Ros2ReaderError
-from rosbags.serde import SerdeError
 
 from rgbd_eval.config import IoConfig
 from rgbd_eval.errors import (
@@ -47,21 +43,12 @@ from rgbd_eval.io.messages import (
     IMAGE_TYPE,
     ODOMETRY_TYPE,
     TF_TYPE,
-    typestore,
 )
+from rgbd_eval.io.source import READ_ERRORS, MessageSource, open_source
 from rgbd_eval.io.sync import Pairing, first_non_increasing, pair_nearest
 from rgbd_eval.io.tf import TfBuffer, TransformLookupError
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Frame, Pose
 
-_READ_ERRORS = (
-    AnyReaderError,
-    Ros1ReaderError,
-    Ros2ReaderError,
-    SerdeError,
-    OSError,
-    struct.error,
-    EOFError,
-)
 _IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
 
 
@@ -234,24 +221,20 @@ class Recording:
         next_k = 0
         info = self.info
         try:
-            with AnyReader(
-                [self.path], default_typestore=typestore(1 if info.container == "ros1" else 2)
-            ) as reader:
-                conns = [c for c in reader.connections if c.topic in (sel.rgb, sel.depth)]
-                for conn, _, raw in reader.messages(connections=conns):
-                    n = counters[conn.topic]
-                    counters[conn.topic] = n + 1
-                    is_rgb = conn.topic == sel.rgb
+            with open_source(self.path) as src:
+                msgtypes = {t: src.topics[t].msgtype for t in (sel.rgb, sel.depth)}
+                for topic, _, raw in src.messages({sel.rgb, sel.depth}):
+                    n = counters[topic]
+                    counters[topic] = n + 1
+                    is_rgb = topic == sel.rgb
                     k = (rgb_want if is_rgb else depth_want).get(n)
                     if k is None:
                         continue
-                    msg = reader.deserialize(raw, conn.msgtype)
+                    msg = src.deserialize(raw, msgtypes[topic])
                     if is_rgb:
-                        rgb_ready[k] = self._decode(msg, conn.topic, info.rgb_camera, color=True)
+                        rgb_ready[k] = self._decode(msg, topic, info.rgb_camera, color=True)
                     else:
-                        depth_ready[k] = self._decode(
-                            msg, conn.topic, info.depth_camera, color=False
-                        )
+                        depth_ready[k] = self._decode(msg, topic, info.depth_camera, color=False)
                     while next_k in rgb_ready and next_k in depth_ready:
                         yield Frame(
                             index=next_k,
@@ -266,7 +249,7 @@ class Recording:
                             has_odometry=info.has_odometry,
                         )
                         next_k += 1
-        except _READ_ERRORS as err:
+        except READ_ERRORS as err:
             raise InputError(self.path, f"read failed after {next_k} frames: {err}") from err
         if next_k != len(self._pairs):
             raise InputError(
@@ -335,21 +318,20 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
     if not path.exists():
         raise InputError(path, "no such file or folder")
     kind = container_kind(path)
-    ros1 = kind == "ros1"
     warnings: list[str] = []
     try:
-        with AnyReader([path], default_typestore=typestore(1 if ros1 else 2)) as reader:
-            conns = list(reader.connections)
-            if not conns or all(c.msgcount == 0 for c in conns):
+        with open_source(path) as src:
+            conns = list(src.topics.values())
+            if not conns or all(c.count == 0 for c in conns):
                 raise InputError(path, "recording is empty (no messages)")
             by_topic = {c.topic: c for c in conns}
-            duration_s = max(0.0, (reader.end_time - reader.start_time) / 1e9)
+            duration_s = max(0.0, (src.end_ns - src.start_ns) / 1e9)
             # Classify image topics by their first message.
-            image_conns = [c for c in conns if c.msgtype in _IMAGE_TYPES and c.msgcount > 0]
+            image_conns = [c for c in conns if c.msgtype in _IMAGE_TYPES and c.count > 0]
             first: dict[str, Any] = {}
             for conn in image_conns:
-                for _, _, raw in reader.messages(connections=[conn]):
-                    first[conn.topic] = reader.deserialize(raw, conn.msgtype)
+                for _, _, raw in src.messages({conn.topic}):
+                    first[conn.topic] = src.deserialize(raw, conn.msgtype)
                     break
             depth_cands = [t for t, m in first.items() if _is_depth_message(m)]
             rgb_cands = [t for t, m in first.items() if not _is_depth_message(m)]
@@ -369,8 +351,8 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
             selected = SelectedTopics(
                 rgb_topic, depth_topic, rgb_info, depth_info, odom_topic, tf_topics, gt_topic
             )
-            index = _index_pass(path, reader, selected, ros1)
-    except _READ_ERRORS as err:
+            index = _index_pass(path, src, selected)
+    except READ_ERRORS as err:
         raise InputError(path, f"cannot read recording: {err}") from err
 
     def rate(topic: str, count: int) -> float | None:
@@ -382,7 +364,7 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
         return count / duration_s if duration_s > 0 else None
 
     topics = tuple(
-        TopicSummary(c.topic, c.msgtype, c.msgcount, rate(c.topic, c.msgcount))
+        TopicSummary(c.topic, c.msgtype, c.count, rate(c.topic, c.count))
         for c in sorted(by_topic.values(), key=lambda c: c.topic)
     )
     rgb_camera = _camera(path, selected.rgb_info, index, first[rgb_topic], rgb_topic, warnings)
@@ -488,19 +470,18 @@ def _rate(stamps: list[int] | None) -> float | None:
     return (len(stamps) - 1) / span if span > 0 else None
 
 
-def _index_pass(path: Path, reader: AnyReader, sel: SelectedTopics, ros1: bool) -> _Index:
+def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
     index = _Index()
     small = {t for t in (sel.rgb_info, sel.depth_info, sel.odometry, sel.ground_truth) if t}
     small.update(sel.tf)
     wanted = small | {sel.rgb, sel.depth}
-    conns = [c for c in reader.connections if c.topic in wanted]
-    for conn, log_ns, raw in reader.messages(connections=conns):
-        topic = conn.topic
+    for topic, log_ns, raw in src.messages(wanted):
+        msgtype = src.topics[topic].msgtype
         if topic in (sel.rgb, sel.depth):
-            index.stamps.setdefault(topic, []).append(_header_stamp(raw, ros1))
+            index.stamps.setdefault(topic, []).append(_header_stamp(raw, src.ros1))
             continue
         index.log_stamps.setdefault(topic, []).append(log_ns)
-        msg: Any = reader.deserialize(raw, conn.msgtype)
+        msg: Any = src.deserialize(raw, msgtype)
         if topic in (sel.rgb_info, sel.depth_info):
             index.first_msgs.setdefault(topic, msg)
         elif topic == sel.odometry:
@@ -517,7 +498,7 @@ def _index_pass(path: Path, reader: AnyReader, sel: SelectedTopics, ros1: bool) 
                 False,
                 topic,
             )
-        elif conn.msgtype == TF_TYPE:
+        elif msgtype == TF_TYPE:
             static = topic.endswith("tf_static")
             for t in msg.transforms:
                 tr = t.transform

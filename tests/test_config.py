@@ -1,0 +1,74 @@
+"""Config: thesis defaults, unknown keys rejected, typed --set overrides."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rgbd_eval.config import Gating, build_config, load_config, parse_overrides
+from rgbd_eval.errors import ConfigError
+
+
+def test_defaults_are_the_thesis_tables() -> None:
+    c = load_config(method="basso2012")
+    # Table 5.1 (voxel 0.06 m)
+    d = c.detector
+    assert (d.voxel_size, d.min_height, d.max_height, d.min_confidence) == (0.06, 1.4, 2.3, -1.5)
+    assert (d.max_distance, d.min_points, d.max_points) == (6.5, 30, 600)
+    assert d.publish_all and d.head_centroid
+    # Table 6.1
+    t = c.tracker
+    assert (t.gate_distance_probability, t.acceleration_variance) == (0.999, 4.0)
+    assert (t.weak_classifiers, t.selectors, t.min_prediction, t.min_confidence) == (250, 50, 9.0, -0.5)
+    assert (t.frames_before_old, t.frames_before_fake, t.frames_remain_new, t.detections_to_validate) == (
+        90, 60, 30, 3,
+    )
+    assert t.seconds(t.frames_before_old) == 3.0  # 90 frames at the Kinect's 30 Hz
+    assert c.evaluation.gating is Gating.IOU and c.evaluation.effective_threshold() == 0.5
+    # The YAML restates exactly the model defaults.
+    assert c == build_config({"method": "basso2012"})
+
+
+def test_overrides_are_typed() -> None:
+    c = build_config({}, parse_overrides(["tracker.min_confidence=-1", "evaluation.gating=metric"]))
+    assert c.tracker.min_confidence == -1.0
+    assert c.evaluation.effective_threshold() == 1.0
+    with pytest.raises(ConfigError, match=r"tracker.min_confidence: .*\(got 'abc'\)"):
+        build_config({}, parse_overrides(["tracker.min_confidence=abc"]))
+    with pytest.raises(ConfigError, match=r"unknown key 'min_conf' in tracker \(known: .*min_confidence"):
+        build_config({}, parse_overrides(["tracker.min_conf=1"]))
+    with pytest.raises(ConfigError, match="expected KEY=VALUE"):
+        parse_overrides(["tracker.min_confidence"])
+    with pytest.raises(ConfigError, match=r"tracker\.min_confidence is not a section"):
+        build_config({}, parse_overrides(["tracker.min_confidence.x=1"]))
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        ({"tracker": {"bogus": 1}}, r"tracker.bogus: unknown key"),
+        ({"detector": {"min_height": 2.5}}, "min_height=2.5 must be below max_height=2.3"),
+        ({"detector": {"voxel_size": 0}}, r"detector.voxel_size: Input should be greater than 0"),
+        ({"tracker": {"gate_distance_probability": 1.0}}, "gate_distance_probability"),
+        ({"tracker": {"selectors": 300}}, "selectors=300 must not exceed weak_classifiers=250"),
+        ({"evaluation": {"gating": "iou", "threshold": 1.5}}, r"IoU threshold=1.5 must be in \(0, 1\]"),
+        ({"detector": {"ground_mode": "points"}}, "ground_mode 'points' needs"),
+    ],
+)
+def test_invalid_values_are_named(data: dict[str, object], match: str) -> None:
+    with pytest.raises(ConfigError, match=match):
+        build_config(data)
+
+
+def test_yaml_errors(tmp_path: Path) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("tracker: [1, 2\n")
+    with pytest.raises(ConfigError, match="not valid YAML"):
+        load_config(bad)
+    lst = tmp_path / "list.yaml"
+    lst.write_text("- 1\n")
+    with pytest.raises(ConfigError, match="expected a mapping"):
+        load_config(lst)
+    with pytest.raises(ConfigError, match="cannot read config"):
+        load_config(tmp_path / "missing.yaml")
