@@ -203,6 +203,19 @@ class TrackerConfig(_Model):
         -3.0, description="HOG threshold when selection is 'confidence' (7.3)"
     )
     seed: int = Field(0, description="seed of the classifier's random features")
+    initial_velocity_variance: float = Field(
+        1.0,
+        gt=0.0,
+        description="variance (m^2/s^2) of a new track's unknown velocity; not given in "
+        "seed 000 (6.1): 1 m/s standard deviation covers walking speeds",
+    )
+    classifier_learning_rate: float = Field(
+        0.05,
+        gt=0.0,
+        le=1.0,
+        description="floor of the gain of the weak classifiers' running class means "
+        "(seed 000 6.5.3 follows Grabner and Bischof [13]; the value is not given)",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> TrackerConfig:
@@ -294,13 +307,17 @@ def _set_dotted(data: dict[str, Any], key: str, value: Any) -> None:
         where = ".".join(parts[:i]) or "<root>"
         if part not in fields:
             allowed = ", ".join(sorted(fields))
-            raise ConfigError(f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})")
+            raise ConfigError(
+                f"override {key!r}: unknown key {part!r} in {where} (known: {allowed})"
+            )
         if i == len(parts) - 1:
             node[part] = value
             return
         annotation = fields[part].annotation
         if not (isinstance(annotation, type) and issubclass(annotation, BaseModel)):
-            raise ConfigError(f"override {key!r}: {where}.{part} is not a section".replace("<root>.", ""))
+            raise ConfigError(
+                f"override {key!r}: {where}.{part} is not a section".replace("<root>.", "")
+            )
         sub = node.setdefault(part, {})
         if not isinstance(sub, dict):
             raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])} is not a section")

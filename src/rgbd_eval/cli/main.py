@@ -6,6 +6,7 @@ import typer
 
 from rgbd_eval import __version__
 from rgbd_eval.cli.inspect_cmd import inspect
+from rgbd_eval.cli.run import run
 
 app = typer.Typer(
     name="rgbd-eval",
@@ -14,6 +15,7 @@ app = typer.Typer(
     add_completion=False,
     pretty_exceptions_enable=False,
 )
+app.command("run")(run)
 app.command("inspect")(inspect)
 
 

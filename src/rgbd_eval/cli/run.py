@@ -1,0 +1,168 @@
+"""``rgbd-eval run``: detect, track and score recordings; write a report folder."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.progress import (
+    BarColumn,
+    MofNCompleteColumn,
+    Progress,
+    TaskID,
+    TextColumn,
+    TimeRemainingColumn,
+)
+from rich.table import Table
+
+from rgbd_eval.cli.common import console, err_console, handle_errors
+from rgbd_eval.config import RunConfig, load_config, repo_root
+from rgbd_eval.errors import InputError
+
+if TYPE_CHECKING:
+    from rgbd_eval.pipeline import SequenceResult
+
+RECORDING_SUFFIXES = (".bag", ".mcap", ".db3")
+
+
+def default_demo() -> Path:
+    return repo_root() / "datasets" / "demo.mcap"
+
+
+def expand_inputs(paths: list[Path]) -> list[Path]:
+    """Recordings named on the command line; a plain folder stands for the recordings in it."""
+    out: list[Path] = []
+    for p in paths:
+        if p.is_dir() and not (p / "metadata.yaml").exists():
+            found = sorted(
+                c
+                for c in p.iterdir()
+                if (c.is_file() and c.suffix in RECORDING_SUFFIXES)
+                or (c.is_dir() and (c / "metadata.yaml").exists())
+            )
+            if not found:
+                raise InputError(
+                    p, "folder holds no recordings (.bag, .mcap, .db3 or ROS2 bag folders)"
+                )
+            out.extend(found)
+        else:
+            out.append(p)
+    names = [p.name for p in out]
+    dupes = {n for n in names if names.count(n) > 1}
+    if dupes:
+        raise InputError(
+            out[0], f"two inputs share the name {sorted(dupes)[0]!r}; reports would collide"
+        )
+    return out
+
+
+def ensure_demo(path: Path) -> None:
+    """The demo recording must exist (``make run`` generates it)."""
+    if not path.exists():
+        raise InputError(path, "demo recording not found; generate it with `make run`")
+
+
+def print_table(results: list[SequenceResult], config: RunConfig) -> None:
+    from rgbd_eval.report import table_header, table_rows
+
+    scored = [r for r in results if r.scores is not None]
+    if scored:
+        table = Table(
+            title=f"{config.method}, gating {config.evaluation.gating.value} "
+            f"(threshold {config.evaluation.effective_threshold()})",
+            title_justify="left",
+        )
+        for i, head in enumerate(table_header()):
+            table.add_column(head, justify="left" if i == 0 else "right")
+        for row in table_rows(results, config.evaluation.gating):
+            table.add_row(*row, style="bold" if row[0] == "overall" else None)
+        console.print(table)
+    for r in results:
+        if r.scores is None:
+            console.print(
+                f"{r.name}: no ground truth found; nothing scored "
+                f"({sum(len(d) for d in r.detections.detections)} detections, tracks written)"
+            )
+        for w in r.info.warnings:
+            console.print(f"[yellow]warning:[/] {r.name}: {w}")
+
+
+@handle_errors
+def run(
+    paths: Annotated[
+        list[Path] | None,
+        typer.Argument(help="recordings or folders of recordings (default: the demo)"),
+    ] = None,
+    method: Annotated[
+        str | None, typer.Option(help="detector/tracker pairing (default: basso2012)")
+    ] = None,
+    gt: Annotated[
+        Path | None, typer.Option(help="ground-truth file (CSV or KTP) for a single recording")
+    ] = None,
+    gating: Annotated[
+        str | None, typer.Option(help="'iou' (image boxes) or 'metric' (ground plane)")
+    ] = None,
+    threshold: Annotated[
+        float | None, typer.Option(help="IoU >= x, or distance <= x metres")
+    ] = None,
+    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
+    overrides: Annotated[
+        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="output folder (default: runs/<time>-<method>)")
+    ] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="print report.json on stdout instead of a table")
+    ] = False,
+) -> None:
+    """Run the pipeline on recordings and score it against their ground truth."""
+    from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
+    from rgbd_eval.report import write_run
+
+    sets = list(overrides or [])
+    if gating is not None:
+        sets.append(f"evaluation.gating={gating}")
+    if threshold is not None:
+        sets.append(f"evaluation.threshold={threshold}")
+    config = load_config(config_file, sets, method=method or (None if config_file else "basso2012"))
+    inputs = list(paths or [])
+    if not inputs:
+        demo = default_demo()
+        ensure_demo(demo)
+        inputs = [demo]
+    recordings = expand_inputs(inputs)
+    if gt is not None and len(recordings) > 1:
+        raise InputError(
+            gt, "--gt applies to a single recording; use <name>.gt.csv sidecars for several"
+        )
+    out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
+    results: list[SequenceResult] = []
+    with Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeRemainingColumn(),
+        console=err_console,
+        transient=True,
+        disable=not err_console.is_terminal,
+    ) as progress:
+        for path in recordings:
+            task = progress.add_task(path.name, total=None)
+
+            def advance(done: int, total: int, task: TaskID = task) -> None:
+                progress.update(task, completed=done, total=total)
+
+            results.append(run_sequence(path, config, gt, advance))
+            progress.remove_task(task)
+    report = write_run(out_dir, results, config)
+    if json_out:
+        typer.echo(json.dumps(report, indent=2))
+    else:
+        print_table(results, config)
+        console.print(
+            f"report: {out_dir / 'report.md'} (machine-readable: {out_dir / 'report.json'})"
+        )

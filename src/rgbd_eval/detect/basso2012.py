@@ -1,0 +1,338 @@
+"""The basso2012 detector: ground-based clustering with HOG confidence (seed 000, chapter 5).
+
+Per frame (Figure 5.1): depth -> point cloud -> voxel grid -> ground plane
+(refined, then removed) -> Euclidean clusters -> head-based sub-clusters
+(Munaro, Basso and Menegatti, IROS 2012) -> features of each cluster (5.3) ->
+HOG confidence on the full-body box -> world-frame :class:`Detection` s.
+
+State: the ground plane, carried from frame to frame (5.1). Create one detector
+per sequence and feed its frames in order; the result is deterministic. Until a
+ground plane is found (automatic mode on a frame without floor, pixel mode on
+a frame without depth under the pixels) :meth:`detect` returns no detections.
+
+``last_timings`` holds the seconds spent in each stage of the last call:
+``pointcloud``, ``voxel``, ``ground``, ``clustering``, ``subclustering``,
+``features``, ``hog``.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rgbd_eval.config import DetectorConfig, RunConfig
+from rgbd_eval.detect.cloud import PointCloud, VoxelGrid, depth_to_cloud, voxel_grid
+from rgbd_eval.detect.clustering import (
+    euclidean_clusters,
+    filter_cluster_sizes,
+    ground_basis,
+    merge_close_clusters,
+    split_by_heads,
+)
+from rgbd_eval.detect.features import (
+    ClusterGeometry,
+    blob_pixels,
+    box_inside_image,
+    cluster_geometry,
+    colour_histogram,
+    full_body_box,
+    occluded_by_nearer_points,
+    project_to_rgb,
+)
+from rgbd_eval.detect.ground import GroundPlaneEstimator
+from rgbd_eval.detect.hog import hog_confidences
+from rgbd_eval.detect.plane import signed_heights
+from rgbd_eval.detect.protocol import Detector, register_detector
+from rgbd_eval.types import Box2D, Box3D, CameraModel, Detection, Frame
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+STAGES = ("pointcloud", "voxel", "ground", "clustering", "subclustering", "features", "hog")
+
+
+class _Stopwatch:
+    def __init__(self) -> None:
+        self.timings: dict[str, float] = dict.fromkeys(STAGES, 0.0)
+        self._last = time.perf_counter()
+
+    def lap(self, stage: str) -> None:
+        now = time.perf_counter()
+        self.timings[stage] += now - self._last
+        self._last = now
+
+
+class _Candidate:
+    """A cluster that passed the height and distance filters, before HOG."""
+
+    def __init__(
+        self,
+        geometry: ClusterGeometry,
+        box: Box2D,
+        box3d: Box3D,
+        occluded: bool,
+        hog_eligible: bool,
+        appearance: NDArray[np.float32],
+    ) -> None:
+        self.geometry = geometry
+        self.box = box
+        self.box3d = box3d
+        self.occluded = occluded
+        self.hog_eligible = hog_eligible
+        self.appearance = appearance
+
+
+class Basso2012Detector:
+    """The reference detector of seed 000 (chapter 5), with head-based sub-clustering."""
+
+    def __init__(self, config: DetectorConfig) -> None:
+        if not isinstance(config, DetectorConfig):
+            raise TypeError(f"config must be a DetectorConfig, got {type(config).__name__}")
+        self.config = config
+        self.ground = GroundPlaneEstimator(config)
+        self.last_timings: dict[str, float] = dict.fromkeys(STAGES, 0.0)
+        self._rays: dict[CameraModel, FloatArray] = {}
+
+    @property
+    def ground_plane(self) -> FloatArray | None:
+        """The current floor plane ``(a, b, c, d)`` in the depth optical frame (unit normal up)."""
+        return self.ground.plane
+
+    def detect(self, frame: Frame) -> list[Detection]:
+        """Detect people in one frame; detections in the world frame, nearest first."""
+        _check_frame(frame)
+        cfg = self.config
+        clock = _Stopwatch()
+        try:
+            cloud = depth_to_cloud(
+                frame.depth, self._rays_for(frame.depth_camera), cfg.max_distance
+            )
+            clock.lap("pointcloud")
+            grid = voxel_grid(cloud.points, cfg.voxel_size)
+            clock.lap("voxel")
+            plane = self._ground_plane(frame, cloud, grid)
+            clock.lap("ground")
+            if plane is None:
+                return []
+            candidates = self._candidates(frame, plane, cloud, grid, clock)
+            confidences = np.full(len(candidates), cfg.hog_default_confidence)
+            eligible = [i for i, c in enumerate(candidates) if c.hog_eligible]
+            if eligible:
+                scores = hog_confidences(frame.rgb, [candidates[i].box for i in eligible])
+                confidences[eligible] = scores
+            clock.lap("hog")
+            return self._detections(frame, candidates, confidences)
+        finally:
+            self.last_timings = clock.timings
+
+    # ------------------------------------------------------------------ stages
+
+    def _rays_for(self, camera: CameraModel) -> FloatArray:
+        rays = self._rays.get(camera)
+        if rays is None:
+            rays = camera.rays()
+            self._rays[camera] = rays
+        return rays
+
+    def _ground_plane(self, frame: Frame, cloud: PointCloud, grid: VoxelGrid) -> FloatArray | None:
+        if self.ground.plane is None:
+            uv, _ = project_to_rgb(cloud.points, frame.depth_to_rgb, frame.rgb_camera)
+            plane = self.ground.initialise(
+                grid.centroids,
+                frame.camera_pose,
+                uv,
+                cloud.points,
+                pixel_radius=2.0 * _footprint(frame),
+            )
+            if plane is None:
+                return None
+            self.ground.plane = plane
+        odometry = frame.camera_pose if frame.has_odometry else None
+        return self.ground.update(grid.centroids, odometry)
+
+    def _candidates(
+        self,
+        frame: Frame,
+        plane: FloatArray,
+        cloud: PointCloud,
+        grid: VoxelGrid,
+        clock: _Stopwatch,
+    ) -> list[_Candidate]:
+        cfg = self.config
+        heights_all = signed_heights(grid.centroids, plane)
+        above = np.flatnonzero(heights_all > cfg.voxel_size)  # ground band: one voxel (5.4.2)
+        pts, heights = grid.centroids[above], heights_all[above]
+        # Every connected piece is kept until merged: a head cut from its body by an
+        # occluder is a small piece, rejoined by the merge (Munaro et al. 2012).
+        pieces = euclidean_clusters(pts, cfg.cluster_tolerance_voxels * cfg.voxel_size, 1)
+        clusters = filter_cluster_sizes(pieces, cfg.min_points, None)  # 5.4.2
+        clock.lap("clustering")
+        if cfg.subclustering:
+            ground_xy = pts @ ground_basis(plane[:3]).T
+            people = merge_close_clusters(ground_xy, pieces, cfg.min_head_distance)
+            people = split_by_heads(
+                ground_xy,
+                heights,
+                people,
+                cfg.voxel_size,
+                cfg.min_head_distance,
+                cfg.min_head_prominence,
+            )
+            people = filter_cluster_sizes(people, cfg.min_points, cfg.max_points)
+        else:
+            people = filter_cluster_sizes(clusters, cfg.min_points, cfg.max_points)
+        clock.lap("subclustering")
+        out = self._evaluate(frame, plane, cloud, grid, above, clusters, people)
+        clock.lap("features")
+        return out
+
+    def _evaluate(
+        self,
+        frame: Frame,
+        plane: FloatArray,
+        cloud: PointCloud,
+        grid: VoxelGrid,
+        above: IntArray,
+        clusters: IntArray,
+        people: IntArray,
+    ) -> list[_Candidate]:
+        """Features of 5.3 for every person cluster; height and distance filters (5.4.2)."""
+        cfg = self.config
+        k = int(people.max()) + 1 if people.size else 0
+        if k == 0:
+            return []
+        pts = grid.centroids[above]
+        # Full-resolution points inherit the label of their voxel.
+        voxel_label = np.full(grid.centroids.shape[0], -1, dtype=np.int64)
+        voxel_label[above] = people
+        point_label = voxel_label[grid.point_voxel]
+        labelled = np.flatnonzero(point_label >= 0)
+        order = np.argsort(point_label[labelled], kind="stable")
+        full_sorted = labelled[order]
+        full_bounds = np.searchsorted(point_label[full_sorted], np.arange(k + 1))
+
+        uv, _ = project_to_rgb(pts, frame.depth_to_rgb, frame.rgb_camera)
+        ranges = np.linalg.norm(pts, axis=1)
+        clustered = clusters >= 0
+        margin = cfg.cluster_tolerance_voxels * cfg.voxel_size
+        footprint = _footprint(frame)
+
+        geometries = [
+            cluster_geometry(
+                pts[people == c],
+                cloud.points[full_sorted[full_bounds[c] : full_bounds[c + 1]]],
+                plane,
+                cfg.head_centroid,
+                cfg.surface_correction,
+            )
+            for c in range(k)
+        ]
+        candidates: list[tuple[float, _Candidate]] = []
+        for c in sorted(range(k), key=lambda i: geometries[i].distance):  # 5.4.2: by distance
+            g = geometries[c]
+            if not (cfg.min_height <= g.height <= cfg.max_height) or g.distance > cfg.max_distance:
+                continue
+            mine = people == c
+            box = full_body_box(g, uv[mine], frame.depth_to_rgb, frame.rgb_camera)
+            if box is None:
+                continue
+            others = clustered & ~mine
+            members = full_sorted[full_bounds[c] : full_bounds[c + 1]]
+            cut_top, cut_bottom, cut_side = _touches_border(
+                cloud.pixels[members], frame.depth_camera
+            )
+            in_view = box_inside_image(box, frame.rgb_camera) and not (
+                cut_top or cut_bottom or cut_side
+            )
+            occluded = (not in_view) or occluded_by_nearer_points(
+                box, float(ranges[mine].min()), uv[others], ranges[others], margin
+            )
+            centre_u = box.left + 0.5 * box.width
+            hog_eligible = (
+                g.lowest <= cfg.hog_max_ground_gap
+                and not (cut_top or cut_bottom)
+                and box.top >= -0.5
+                and box.bottom <= frame.rgb_camera.height - 0.5
+                and 0.0 <= centre_u < frame.rgb_camera.width
+            )
+            blob_uv, _ = project_to_rgb(cloud.points[members], frame.depth_to_rgb, frame.rgb_camera)
+            appearance = colour_histogram(
+                frame.rgb, blob_pixels(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
+            )
+            box3d = _world_box(frame, np.vstack([pts[mine], g.ground_point[None, :]]))
+            candidates.append(
+                (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, appearance))
+            )
+        return [c for _, c in candidates]
+
+    def _detections(
+        self, frame: Frame, candidates: list[_Candidate], confidences: FloatArray
+    ) -> list[Detection]:
+        cfg = self.config
+        out = []
+        for cand, conf in zip(candidates, confidences.tolist(), strict=True):
+            if not cfg.publish_all and conf < cfg.min_confidence:  # Table 5.1
+                continue
+            position = frame.camera_pose.transform_points(
+                cand.geometry.theoretical_centroid[None, :]
+            )[0]
+            out.append(
+                Detection(
+                    position=(float(position[0]), float(position[1]), float(position[2])),
+                    height=cand.geometry.height,
+                    confidence=float(conf),
+                    box2d=cand.box,
+                    box3d=cand.box3d,
+                    distance=cand.geometry.distance,
+                    occluded=cand.occluded,
+                    appearance=cand.appearance,
+                )
+            )
+        return out
+
+
+def _footprint(frame: Frame) -> int:
+    """RGB pixels per depth pixel (per side), at least 1."""
+    return max(1, round(frame.rgb_camera.fx / frame.depth_camera.fx))
+
+
+def _touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
+    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
+    if pixels.shape[0] == 0:
+        return (False, False, False)
+    rows, cols = np.divmod(pixels, camera.width)
+    return (
+        bool(rows.min() == 0),
+        bool(rows.max() == camera.height - 1),
+        bool(cols.min() == 0 or cols.max() == camera.width - 1),
+    )
+
+
+def _world_box(frame: Frame, points: FloatArray) -> Box3D:
+    world = frame.camera_pose.transform_points(points)
+    lo, hi = world.min(axis=0), world.max(axis=0)
+    return Box3D(
+        (float(lo[0]), float(lo[1]), float(lo[2])), (float(hi[0]), float(hi[1]), float(hi[2]))
+    )
+
+
+def _check_frame(frame: Frame) -> None:
+    dc, rc = frame.depth_camera, frame.rgb_camera
+    if frame.depth.shape != (dc.height, dc.width):
+        raise ValueError(
+            f"frame {frame.index}: depth image is {frame.depth.shape}, "
+            f"depth camera is {dc.width}x{dc.height}"
+        )
+    if frame.rgb.dtype != np.uint8 or frame.rgb.shape != (rc.height, rc.width, 3):
+        raise ValueError(
+            f"frame {frame.index}: rgb image is {frame.rgb.dtype} {frame.rgb.shape}, "
+            f"expected uint8 ({rc.height}, {rc.width}, 3)"
+        )
+
+
+@register_detector("basso2012")
+def create_basso2012(config: RunConfig) -> Detector:
+    """Registry factory: the basso2012 detector from ``config.detector``."""
+    return Basso2012Detector(config.detector)

@@ -1,0 +1,32 @@
+"""Scoring: CLEAR MOT with the thesis' extras, gated by image IoU or ground-plane distance.
+
+``evaluate_sequence`` scores one sequence into summable :class:`Counts`;
+``summarize(total(...))`` derives every ratio for one or many sequences.
+"""
+
+from rgbd_eval.metrics.clear import FrameEvents, Match, SequenceScores, evaluate_sequence
+from rgbd_eval.metrics.counts import COUNTS_SCHEMA, Counts, Summary, summarize, total
+from rgbd_eval.metrics.gating import (
+    distance_matrix,
+    ground_distance_matrix,
+    iou_distance_matrix,
+    iou_matrix,
+    metric_distance_matrix,
+)
+
+__all__ = [
+    "COUNTS_SCHEMA",
+    "Counts",
+    "FrameEvents",
+    "Match",
+    "SequenceScores",
+    "Summary",
+    "distance_matrix",
+    "evaluate_sequence",
+    "ground_distance_matrix",
+    "iou_distance_matrix",
+    "iou_matrix",
+    "metric_distance_matrix",
+    "summarize",
+    "total",
+]

@@ -1,0 +1,183 @@
+"""What one frame contributes to scoring: scored ground truth, scored tracks, ignored ones.
+
+- A track is scored when it is ``VALIDATED`` and not ``NOT_VISIBLE``.
+- A ground-truth object is ignored when ``ignore`` is set or its visibility is
+  below ``min_visibility``. Ignored objects neither count as a miss nor make a
+  false positive of a track sitting on them: scored tracks are first matched to
+  the ignored objects (inside the gate, Hungarian, most pairs first, then least
+  total distance) and the matched tracks are dropped from the frame; the rest is
+  scored normally.
+- IoU gating needs ``box2d`` on scored tracks and scored ground truth; metric
+  gating needs ``world_xyz`` on scored ground truth (tracks always have x, y).
+  An ignored object lacking the field (a person out of the image has no box)
+  stays ignored and drops no track.
+
+Ids must be unique per frame and smaller than 2**53 in magnitude (motmetrics
+stores them as float64).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+
+from rgbd_eval.config import Gating
+from rgbd_eval.errors import ScoringError
+from rgbd_eval.metrics.gating import FloatArray, distance_matrix
+from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
+
+_MAX_ID = 2**53
+
+
+@dataclass(frozen=True)
+class FrameSelection:
+    """The scored part of one frame, ready for a distance matrix.
+
+    ``gt_values``/``track_values`` are ``(N, 4)`` boxes (IoU gating) or ``(N, 2)``
+    ground-plane positions (metric gating), row-aligned with the ids.
+    ``present_track_ids`` are all scored tracks, including the dropped ones.
+    """
+
+    gt_ids: list[int]
+    gt_values: FloatArray
+    track_ids: list[int]
+    track_values: FloatArray
+    ignored_gt_ids: list[int]
+    dropped_track_ids: list[int]
+    present_track_ids: frozenset[int]
+
+
+def is_scored_track(track: TrackOutput) -> bool:
+    """Whether a track output takes part in scoring (validated and visible or occluded)."""
+    return track.status is TrackStatus.VALIDATED and track.visibility is not Visibility.NOT_VISIBLE
+
+
+def is_ignored(gt: GroundTruthObject, min_visibility: float) -> bool:
+    """Whether a ground-truth object is ignored (flagged, or less visible than allowed)."""
+    return gt.ignore or gt.visibility < min_visibility
+
+
+def _check_ids(frame: int, what: str, ids: list[int]) -> None:
+    if len(set(ids)) != len(ids):
+        repeated = sorted({i for i in ids if ids.count(i) > 1})
+        raise ScoringError(f"frame {frame}: {what} id(s) {repeated} appear more than once")
+    if ids and (max(ids) >= _MAX_ID or min(ids) <= -_MAX_ID):
+        raise ScoringError(f"frame {frame}: {what} ids must be smaller than 2**53 in magnitude")
+
+
+def _gt_values(
+    frame: int, objects: Sequence[GroundTruthObject], gating: Gating, required: bool
+) -> tuple[list[int], FloatArray]:
+    ids: list[int] = []
+    rows: list[tuple[float, ...]] = []
+    for gt in objects:
+        if gating is Gating.IOU:
+            value: tuple[float, ...] | None = gt.box2d.as_tuple() if gt.box2d is not None else None
+            needed = "2D box (box2d), needed for IoU gating"
+        else:
+            value = gt.world_xyz[:2] if gt.world_xyz is not None else None
+            needed = "world position (world_xyz), needed for metric gating"
+        if value is None:
+            if required:
+                raise ScoringError(f"frame {frame}: ground-truth id {gt.object_id} has no {needed}")
+            continue
+        ids.append(gt.object_id)
+        rows.append(value)
+    return ids, _rows(frame, "ground-truth", ids, rows, gating)
+
+
+def _track_values(
+    frame: int, tracks: Sequence[TrackOutput], gating: Gating
+) -> tuple[list[int], FloatArray]:
+    ids = [t.track_id for t in tracks]
+    rows: list[tuple[float, ...]] = []
+    if gating is Gating.IOU:
+        for t in tracks:
+            if t.box2d is None:
+                raise ScoringError(
+                    f"frame {frame}: track id {t.track_id} has no 2D box (box2d), "
+                    "needed for IoU gating"
+                )
+            rows.append(t.box2d.as_tuple())
+    else:
+        rows = [(t.x, t.y) for t in tracks]
+    return ids, _rows(frame, "track", ids, rows, gating)
+
+
+def _rows(
+    frame: int, what: str, ids: list[int], rows: list[tuple[float, ...]], gating: Gating
+) -> FloatArray:
+    if not rows:
+        return np.zeros((0, 4 if gating is Gating.IOU else 2))
+    values = np.array(rows, dtype=np.float64)
+    if np.isfinite(values).all() and (gating is Gating.METRIC or values[:, 2:].min() >= 0):
+        return values
+    bad = ~np.isfinite(values).all(axis=1)
+    if gating is Gating.IOU:
+        bad |= (values[:, 2:] < 0).any(axis=1)
+    index = int(np.flatnonzero(bad)[0])
+    kind = "box" if gating is Gating.IOU else "position"
+    raise ScoringError(
+        f"frame {frame}: {what} id {ids[index]} has an invalid {kind} {rows[index]} "
+        "(values must be finite, box width and height >= 0)"
+    )
+
+
+def tracks_on_ignored(
+    ignored_values: FloatArray, track_values: FloatArray, gating: Gating, threshold: float
+) -> list[int]:
+    """Indices of the tracks matched to ignored ground truth (gated Hungarian)."""
+    if len(ignored_values) == 0 or len(track_values) == 0:
+        return []
+    distances = distance_matrix(gating, ignored_values, track_values, threshold)
+    valid = np.isfinite(distances)
+    if not valid.any():
+        return []
+    # Invalid pairs cost more than any full set of valid ones, so the assignment
+    # first maximises the number of gated pairs, then minimises their distance.
+    forbidden = (np.nanmax(distances) + 1.0) * (min(distances.shape) + 1)
+    rows, cols = linear_sum_assignment(np.where(valid, distances, forbidden))
+    return sorted(int(c) for r, c in zip(rows, cols, strict=True) if valid[r, c])
+
+
+def select_frame(
+    frame: int,
+    gt_objects: Sequence[GroundTruthObject],
+    tracks: Sequence[TrackOutput],
+    gating: Gating,
+    threshold: float,
+    min_visibility: float,
+) -> FrameSelection:
+    """Split one frame into scored and ignored parts (see the module docstring)."""
+    scored_gt: list[GroundTruthObject] = []
+    ignored_gt: list[GroundTruthObject] = []
+    for gt in gt_objects:
+        (ignored_gt if is_ignored(gt, min_visibility) else scored_gt).append(gt)
+    scored_tracks = [t for t in tracks if is_scored_track(t)]
+    _check_ids(frame, "ground-truth", [g.object_id for g in gt_objects])
+    track_ids, track_values = _track_values(frame, scored_tracks, gating)
+    _check_ids(frame, "track", track_ids)
+    gt_ids, gt_values = _gt_values(frame, scored_gt, gating, required=True)
+    present = frozenset(track_ids)
+    dropped_ids: list[int] = []
+    if ignored_gt:
+        _, ignored_values = _gt_values(frame, ignored_gt, gating, required=False)
+        dropped = tracks_on_ignored(ignored_values, track_values, gating, threshold)
+        if dropped:
+            keep = np.ones(len(track_ids), dtype=bool)
+            keep[dropped] = False
+            dropped_ids = [track_ids[i] for i in dropped]
+            track_ids = [i for i, k in zip(track_ids, keep.tolist(), strict=True) if k]
+            track_values = track_values[keep]
+    return FrameSelection(
+        gt_ids=gt_ids,
+        gt_values=gt_values,
+        track_ids=track_ids,
+        track_values=track_values,
+        ignored_gt_ids=[g.object_id for g in ignored_gt],
+        dropped_track_ids=dropped_ids,
+        present_track_ids=present,
+    )

@@ -1,0 +1,176 @@
+"""Run one sequence: frames -> detections -> tracks -> scores. No printing, no files.
+
+Each stage is its own function so that sweeps can reuse detections (a pure
+function of the recording and the detector config) and re-run only tracking and
+scoring.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from rgbd_eval.config import Gating, RunConfig
+from rgbd_eval.detect.protocol import create_detector
+from rgbd_eval.errors import ScoringError
+from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
+from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
+from rgbd_eval.metrics import SequenceScores, evaluate_sequence
+from rgbd_eval.track.protocol import create_tracker
+from rgbd_eval.types import Detection, GroundTruthObject, TrackOutput
+
+#: Called after each frame with (frames done, frames in all).
+Progress = Callable[[int, int], None]
+
+
+@dataclass(frozen=True)
+class SequenceDetections:
+    """The detector's output for every frame of a recording."""
+
+    stamps_ns: tuple[int, ...]
+    detections: tuple[tuple[Detection, ...], ...]
+    seconds: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class GroundTruthMatch:
+    """Ground truth aligned with the recording's frames."""
+
+    source: str
+    frames: list[list[GroundTruthObject]]
+    annotated_frames: int
+    unmatched_frames: int
+
+
+@dataclass(frozen=True)
+class SequenceResult:
+    """Everything one run of one sequence produced."""
+
+    name: str
+    path: str
+    info: RecordingInfo
+    detections: SequenceDetections
+    tracks: tuple[tuple[TrackOutput, ...], ...]
+    ground_truth: GroundTruthMatch | None
+    scores: SequenceScores | None
+    seconds: dict[str, float]
+
+
+def sequence_name(path: Path) -> str:
+    """A short name for reports: the file name without its container suffix."""
+    return path.name[: -len(path.suffix)] if path.suffix in (".bag", ".mcap", ".db3") else path.name
+
+
+def sidecar_path(path: Path) -> Path | None:
+    """``<name>.gt.csv`` beside a recording, if present."""
+    candidate = path.with_name(f"{sequence_name(path)}.gt.csv")
+    return candidate if candidate.exists() else None
+
+
+def detect_sequence(
+    recording: Recording, config: RunConfig, progress: Progress | None = None
+) -> SequenceDetections:
+    """Run the configured detector on every frame (a fresh detector per sequence)."""
+    detector = create_detector(config.method, config)
+    stamps: list[int] = []
+    per_frame: list[tuple[Detection, ...]] = []
+    read_s = detect_s = 0.0
+    total = len(recording)
+    start = time.perf_counter()
+    for frame in recording.frames():
+        t0 = time.perf_counter()
+        read_s += t0 - start
+        per_frame.append(tuple(detector.detect(frame)))
+        stamps.append(frame.stamp_ns)
+        start = time.perf_counter()
+        detect_s += start - t0
+        if progress is not None:
+            progress(len(per_frame), total)
+    return SequenceDetections(tuple(stamps), tuple(per_frame), {"read": read_s, "detect": detect_s})
+
+
+def track_sequence(
+    detections: SequenceDetections, config: RunConfig
+) -> tuple[tuple[TrackOutput, ...], ...]:
+    """Run the configured tracker over per-frame detections (a fresh tracker per sequence)."""
+    tracker = create_tracker(config.method, config)
+    return tuple(
+        tuple(tracker.update(stamp, dets))
+        for stamp, dets in zip(detections.stamps_ns, detections.detections, strict=True)
+    )
+
+
+def match_ground_truth(
+    gt: GroundTruth, stamps_ns: Sequence[int], config: RunConfig
+) -> GroundTruthMatch:
+    """Align annotations with frames by nearest stamp (within the sync gap)."""
+    frames, unmatched = gt.align(stamps_ns, int(config.io.max_sync_gap_ms * 1e6))
+    return GroundTruthMatch(gt.source, frames, len(gt.frames), unmatched)
+
+
+def find_ground_truth(path: Path, recording: Recording, gt_path: Path | None) -> GroundTruth | None:
+    """An explicit file, else the ``<name>.gt.csv`` sidecar, else the ground-truth topic."""
+    if gt_path is not None:
+        return load_ground_truth(gt_path)
+    sidecar = sidecar_path(path)
+    if sidecar is not None:
+        return load_ground_truth(sidecar)
+    return recording.ground_truth_topic
+
+
+def score_sequence(
+    gt: GroundTruthMatch, tracks: Sequence[Sequence[TrackOutput]], config: RunConfig
+) -> SequenceScores:
+    """CLEAR MOT scores of one sequence; ScoringError when nothing can be compared."""
+    if gt.annotated_frames and gt.unmatched_frames == gt.annotated_frames:
+        raise ScoringError(
+            f"{gt.source}: none of its {gt.annotated_frames} annotated frames matches a frame "
+            f"stamp of the recording (within {config.io.max_sync_gap_ms} ms)"
+        )
+    needs = "box2d" if config.evaluation.gating is Gating.IOU else "world_xyz"
+    if not any(getattr(o, needs) is not None for frame in gt.frames for o in frame):
+        other = "metric" if config.evaluation.gating is Gating.IOU else "iou"
+        raise ScoringError(
+            f"{gt.source}: '{config.evaluation.gating.value}' gating needs "
+            f"{'image boxes' if needs == 'box2d' else 'world positions'}, which this ground "
+            f"truth does not have (try --gating {other})"
+        )
+    return evaluate_sequence(gt.frames, tracks, config.evaluation)
+
+
+def run_sequence(
+    path: Path,
+    config: RunConfig,
+    gt_path: Path | None = None,
+    progress: Progress | None = None,
+) -> SequenceResult:
+    """Read, detect, track and (when ground truth exists) score one recording."""
+    path = Path(path)
+    start = time.perf_counter()
+    recording = open_recording(path, config.io)
+    index_s = time.perf_counter() - start
+    gt = find_ground_truth(path, recording, gt_path)
+    detections = detect_sequence(recording, config, progress)
+    start = time.perf_counter()
+    tracks = track_sequence(detections, config)
+    track_s = time.perf_counter() - start
+    matched = scores = None
+    score_s = 0.0
+    if gt is not None:
+        start = time.perf_counter()
+        matched = match_ground_truth(gt, detections.stamps_ns, config)
+        scores = score_sequence(matched, tracks, config)
+        score_s = time.perf_counter() - start
+    seconds = {"index": index_s, **detections.seconds, "track": track_s, "score": score_s}
+    return SequenceResult(
+        name=sequence_name(path),
+        path=str(path),
+        info=recording.info,
+        detections=detections,
+        tracks=tracks,
+        ground_truth=matched,
+        scores=scores,
+        seconds=seconds,
+    )

@@ -1,0 +1,366 @@
+"""Reports of runs: JSON for machines, Markdown and terminal tables for people, CSVs, plots.
+
+A run's output folder is written under a temporary name and renamed when
+complete, so a failed run never leaves a half-written ``report.json`` that a
+later ``compare`` could mistake for a result.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import os
+import shutil
+import tempfile
+from collections.abc import Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import asdict
+from importlib import metadata
+from pathlib import Path
+from typing import Any
+
+from rgbd_eval import __version__
+from rgbd_eval.config import Gating, RunConfig, config_to_dict
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.metrics import Counts, Summary, summarize, total
+from rgbd_eval.pipeline import SequenceResult
+
+REPORT_SCHEMA_VERSION = 1
+_LIBRARIES = (
+    "numpy",
+    "scipy",
+    "opencv-python-headless",
+    "open3d-cpu",
+    "open3d",
+    "rosbags",
+    "mcap",
+    "motmetrics",
+    "pydantic",
+)
+
+#: Table columns in the order of the thesis' Tables 7.2-7.6: (key, header, kind).
+COLUMNS: tuple[tuple[str, str, str], ...] = (
+    ("motp", "MOTP", "motp"),
+    ("mota", "MOTA", "pct"),
+    ("fp_rate", "FP", "pct"),
+    ("fn_rate", "FN", "pct"),
+    ("id_switches", "ID Sw.", "int"),
+    ("main_tr", "Main Tr.", "pct"),
+    ("all_tr", "All Tr.", "pct"),
+    ("idf1", "IDF1", "pct"),
+    ("mt", "MT", "int"),
+    ("ml", "ML", "int"),
+    ("fragmentations", "Frag.", "int"),
+    ("recall_errors", "Rec. err.", "int"),
+)
+
+
+def file_digest(path: Path) -> str:
+    """sha256 of a file, or of a folder's files (names and contents, sorted)."""
+    h = hashlib.sha256()
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    for f in files:
+        if path.is_dir():
+            h.update(str(f.relative_to(path)).encode())
+        with f.open("rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                h.update(block)
+    return h.hexdigest()
+
+
+def library_versions() -> dict[str, str]:
+    out = {}
+    for name in _LIBRARIES:
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            continue
+    return out
+
+
+def format_value(summary: Summary | None, key: str, kind: str, gating: Gating) -> str:
+    """One table cell: percentages as in the thesis, MOTP as % (IoU) or metres."""
+    if summary is None or summary.get(key) is None:
+        return "-"
+    value = summary[key]
+    assert value is not None
+    if kind == "pct" or (kind == "motp" and gating is Gating.IOU):
+        return f"{100.0 * float(value):.1f}%"
+    if kind == "motp":
+        return f"{float(value):.3f} m"
+    return str(int(value))
+
+
+def overall_counts(results: Sequence[SequenceResult]) -> Counts | None:
+    scored = [r.scores.counts for r in results if r.scores is not None]
+    return total(scored) if scored else None
+
+
+def table_rows(results: Sequence[SequenceResult], gating: Gating) -> list[list[str]]:
+    """Rows of the terminal/Markdown table: one per sequence, then 'overall' for several."""
+    rows = []
+    for r in results:
+        summary = r.scores.summary() if r.scores is not None else None
+        cells = [format_value(summary, k, kind, gating) for k, _, kind in COLUMNS]
+        rows.append([r.name, str(r.info.num_frames), *cells])
+    overall = overall_counts(results)
+    if len(results) > 1 and overall is not None:
+        summary = summarize(overall)
+        rows.append(
+            [
+                "overall",
+                str(sum(r.info.num_frames for r in results)),
+                *[format_value(summary, k, kind, gating) for k, _, kind in COLUMNS],
+            ]
+        )
+    return rows
+
+
+def table_header() -> list[str]:
+    return ["sequence", "frames", *(h for _, h, _ in COLUMNS)]
+
+
+def markdown_table(results: Sequence[SequenceResult], gating: Gating) -> str:
+    header = table_header()
+    lines = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in header) + "|"]
+    lines += ["| " + " | ".join(row) + " |" for row in table_rows(results, gating)]
+    return "\n".join(lines) + "\n"
+
+
+def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
+    info = r.info
+    gt = r.ground_truth
+    return {
+        "name": r.name,
+        "path": r.path,
+        "sha256": digest,
+        "frames": info.num_frames,
+        "has_odometry": info.has_odometry,
+        "world_frame": info.world_frame,
+        "sync": asdict(info.sync),
+        "warnings": list(info.warnings),
+        "ground_truth": None
+        if gt is None
+        else {
+            "source": gt.source,
+            "annotated_frames": gt.annotated_frames,
+            "unmatched_frames": gt.unmatched_frames,
+        },
+        "scored": r.scores is not None,
+        "counts": None if r.scores is None else r.scores.counts.to_dict(),
+        "metrics": None if r.scores is None else r.scores.summary(),
+        "detections": sum(len(d) for d in r.detections.detections),
+        "seconds": {k: round(v, 6) for k, v in r.seconds.items()},
+    }
+
+
+def report_dict(
+    results: Sequence[SequenceResult], config: RunConfig, digests: Sequence[str]
+) -> dict[str, Any]:
+    """The content of ``report.json``."""
+    overall = overall_counts(results)
+    gating = config.evaluation.gating
+    return {
+        "schema_version": REPORT_SCHEMA_VERSION,
+        "tool": {"name": "rgbd-eval", "version": __version__},
+        "libraries": library_versions(),
+        "method": config.method,
+        "evaluation": {
+            "gating": gating.value,
+            "threshold": config.evaluation.effective_threshold(),
+            "motp": "mean IoU of matches (higher is better)"
+            if gating is Gating.IOU
+            else "mean ground-plane distance of matches in metres (lower is better)",
+            "matching": "motmetrics: a previous match is kept while it stays within the gate",
+        },
+        "config": config_to_dict(config),
+        "sequences": [sequence_record(r, d) for r, d in zip(results, digests, strict=True)],
+        "overall": None
+        if overall is None
+        else {"counts": overall.to_dict(), "metrics": summarize(overall)},
+    }
+
+
+def _csv(rows: Sequence[Sequence[Any]], header: Sequence[str]) -> str:
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(header)
+    writer.writerows(rows)
+    return buf.getvalue()
+
+
+def _num(v: float) -> str:
+    return f"{v:.4f}"
+
+
+def detections_csv(r: SequenceResult) -> str:
+    header = [
+        "frame",
+        "stamp_ns",
+        "x",
+        "y",
+        "z",
+        "height",
+        "bb_left",
+        "bb_top",
+        "bb_width",
+        "bb_height",
+        "confidence",
+        "occluded",
+        "distance",
+    ]
+    rows = []
+    for i, (stamp, dets) in enumerate(
+        zip(r.detections.stamps_ns, r.detections.detections, strict=True)
+    ):
+        for d in dets:
+            rows.append(
+                [
+                    i,
+                    stamp,
+                    *map(_num, d.position),
+                    _num(d.height),
+                    *map(_num, d.box2d.as_tuple()),
+                    _num(d.confidence),
+                    int(d.occluded),
+                    _num(d.distance),
+                ]
+            )
+    return _csv(rows, header)
+
+
+def tracks_csv(r: SequenceResult) -> str:
+    """MOTChallenge-style rows (frame, id, box, conf, x, y, z) plus stamp, height, visibility, status."""
+    header = [
+        "frame",
+        "id",
+        "bb_left",
+        "bb_top",
+        "bb_width",
+        "bb_height",
+        "conf",
+        "x",
+        "y",
+        "z",
+        "stamp_ns",
+        "height",
+        "visibility",
+        "status",
+    ]
+    rows = []
+    for i, (stamp, tracks) in enumerate(zip(r.detections.stamps_ns, r.tracks, strict=True)):
+        for t in tracks:
+            box = [_num(v) for v in t.box2d.as_tuple()] if t.box2d is not None else ["", "", "", ""]
+            rows.append(
+                [
+                    i,
+                    t.track_id,
+                    *box,
+                    -1,
+                    _num(t.x),
+                    _num(t.y),
+                    _num(t.height / 2),
+                    stamp,
+                    _num(t.height),
+                    t.visibility.name.lower(),
+                    t.status.value,
+                ]
+            )
+    return _csv(rows, header)
+
+
+def birds_eye_png(r: SequenceResult, path: Path) -> None:
+    """Ground-truth (dashed) and tracked (solid) ground-plane trajectories of one sequence."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
+    cmap = plt.get_cmap("tab10")
+    if r.ground_truth is not None:
+        paths: dict[int, list[tuple[float, float]]] = {}
+        for frame in r.ground_truth.frames:
+            for o in frame:
+                if o.world_xyz is not None and not o.ignore:
+                    paths.setdefault(o.object_id, []).append((o.world_xyz[0], o.world_xyz[1]))
+        for k, (oid, pts) in enumerate(sorted(paths.items())):
+            xs, ys = zip(*pts, strict=True)
+            ax.plot(xs, ys, "--", color="0.5", lw=1.5, label="ground truth" if k == 0 else None)
+            ax.annotate(f"gt {oid}", pts[0], color="0.4", fontsize=8)
+    tracks: dict[int, list[tuple[float, float]]] = {}
+    for frame_tracks in r.tracks:
+        for t in frame_tracks:
+            if t.visibility.name != "NOT_VISIBLE" and t.status.value == "validated":
+                tracks.setdefault(t.track_id, []).append((t.x, t.y))
+    for tid, pts in sorted(tracks.items()):
+        xs, ys = zip(*pts, strict=True)
+        ax.plot(xs, ys, "-", color=cmap(tid % 10), lw=1.2, label=f"track {tid}")
+    ax.set_xlabel(f"x [m] ({r.info.world_frame})")
+    ax.set_ylabel(f"y [m] ({r.info.world_frame})")
+    ax.set_title(f"{r.name}: bird's-eye view")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    if tracks or r.ground_truth is not None:
+        ax.legend(fontsize=7, loc="best", ncol=2)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+
+
+@contextmanager
+def staged_output(out_dir: Path) -> Iterator[Path]:
+    """A temporary folder beside ``out_dir`` that replaces it only if the block succeeds."""
+    out_dir = Path(out_dir)
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    if out_dir.exists() and any(out_dir.iterdir()) and not (out_dir / "report.json").exists():
+        raise ConfigError(
+            f"{out_dir}: exists and is not an rgbd-eval output folder; choose another --out"
+        )
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    if out_dir.exists():
+        shutil.rmtree(out_dir)
+    os.replace(tmp, out_dir)
+
+
+def write_run(
+    out_dir: Path, results: Sequence[SequenceResult], config: RunConfig
+) -> dict[str, Any]:
+    """Write every output of a run into ``out_dir`` (atomically as a folder); return the report."""
+    import json
+
+    digests = [file_digest(Path(r.path)) for r in results]
+    report = report_dict(results, config, digests)
+    with staged_output(out_dir) as tmp:
+        for r in results:
+            (tmp / f"{r.name}.detections.csv").write_text(detections_csv(r), encoding="utf-8")
+            (tmp / f"{r.name}.tracks.csv").write_text(tracks_csv(r), encoding="utf-8")
+            birds_eye_png(r, tmp / f"{r.name}.birdseye.png")
+        md = [
+            f"# rgbd-eval run: {config.method}",
+            "",
+            f"Gating: {report['evaluation']['gating']} (threshold {report['evaluation']['threshold']}); "
+            f"MOTP is the {report['evaluation']['motp']}.",
+            "",
+        ]
+        if any(r.scores is not None for r in results):
+            md.append(markdown_table(results, config.evaluation.gating))
+        for r in results:
+            if r.scores is None:
+                md.append(
+                    f"- {r.name}: no ground truth, nothing scored "
+                    f"({sum(len(d) for d in r.detections.detections)} detections written)."
+                )
+            for w in r.info.warnings:
+                md.append(f"- {r.name}: {w}")
+        (tmp / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
+        (tmp / "report.json").write_text(
+            json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
+        )
+    return report

@@ -1,0 +1,373 @@
+"""The basso2012 tracker (seed 000, chapter 6): UKF, two-step GNN, on-line boosted recovery.
+
+Per frame, in the world frame of odometry (6.5.1):
+
+1. predict every track with the constant-velocity UKF over the stamp difference (6.1, 6.5.2);
+2. associate tracks and detections by gated Mahalanobis distance, Hungarian method (6.3);
+3. associate the leftovers by classifier score above ``min_prediction`` (6.3);
+4. update the filters with the theoretical centroids, and the classifiers with the
+   non-occluded detections: own detection positive, other tracks' negative (6.2.2, 6.4.2);
+5. create tracks from leftover detections with HOG confidence above ``min_confidence``,
+   validate them after ``detections_to_validate`` confident detections within
+   ``frames_before_fake``, else discard them (6.4.1, 6.5.4);
+6. recovery: while a track is new (``frames_remain_new``), the classifier of a missing
+   track that accepts its histogram takes it back under the old id (6.4.3);
+7. a track not visible for ``frames_before_old`` leaves the output; its classifier is
+   kept for ``classifier_memory_s`` (Figure 7.7) for steps 3 and 6, then dropped (6.4.4).
+
+Frame counts are turned into seconds at ``reference_rate_hz`` and compared with
+stamp differences, so dropped frames and other rates keep their meaning in time.
+The output height is the last associated detection's height.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rgbd_eval.config import ClusterSelection, RunConfig
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.track import ukf
+from rgbd_eval.track.association import (
+    chi_square_gate,
+    gnn_assign,
+    mahalanobis_sq,
+    score_assign,
+)
+from rgbd_eval.track.boosting import OnlineBoostingClassifier
+from rgbd_eval.track.motion import (
+    apply_measurement,
+    apply_transition,
+    measurement_variance,
+    process_noise,
+)
+from rgbd_eval.track.protocol import register_tracker
+from rgbd_eval.types import Box2D, Detection, TrackOutput, TrackStatus, Visibility
+
+Array = NDArray[np.float64]
+
+#: Slack (ns) when comparing stamp differences with durations, for rounded stamps.
+STAMP_TOLERANCE_NS = 1_000_000
+
+_SIGMA = ukf.sigma_weights(4)
+_EYE2 = np.eye(2)
+
+
+def _ns(seconds: float) -> int:
+    return round(seconds * 1e9)
+
+
+@dataclass
+class _Track:
+    """Book-keeping of one track; its filter state lives in the tracker's arrays."""
+
+    track_id: int
+    created_ns: int
+    last_seen_ns: int
+    confident: int
+    validated: bool
+    height: float
+    classifier: OnlineBoostingClassifier | None
+    detection: int | None = None  # index into this frame's detections, or None
+
+
+@register_tracker("basso2012")
+class Basso2012Tracker:
+    """Tracking by detection with an UKF and on-line boosted re-identification (seed 000, ch. 6)."""
+
+    def __init__(self, config: RunConfig) -> None:
+        cfg = config.tracker
+        if cfg.seed < 0:
+            raise ConfigError(f"tracker.seed={cfg.seed} must be >= 0")
+        self._cfg = cfg
+        self._bins = config.detector.histogram_bins
+        self._voxel = config.detector.voxel_size
+        self._gate = chi_square_gate(cfg.gate_distance_probability, 2)
+        self._old_ns = _ns(cfg.seconds(cfg.frames_before_old))
+        self._fake_ns = _ns(cfg.seconds(cfg.frames_before_fake))
+        self._new_ns = _ns(cfg.seconds(cfg.frames_remain_new))
+        memory_s = (
+            cfg.classifier_memory_s
+            if cfg.classifier_memory_s is not None
+            else cfg.seconds(cfg.frames_before_old)
+        )
+        self._memory_ns = _ns(memory_s)
+        self._x = np.zeros((0, 4))
+        self._P = np.zeros((0, 4, 4))
+        self._tracks: list[_Track] = []
+        self._last_ns: int | None = None
+        self._next_id = 1
+
+    # ------------------------------------------------------------------ public
+
+    def update(self, stamp_ns: int, detections: Sequence[Detection]) -> list[TrackOutput]:
+        """Consume one frame's detections; return every maintained track, ordered by id."""
+        if self._last_ns is not None and stamp_ns <= self._last_ns:
+            raise ValueError(f"stamp_ns={stamp_ns} must increase (previous frame: {self._last_ns})")
+        dets = self._select(detections)
+        dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
+        self._last_ns = stamp_ns
+        z = np.array([d.ground_xy for d in dets], dtype=np.float64).reshape(-1, 2)
+        r = measurement_variance(
+            self._voxel,
+            np.array([d.distance for d in dets], dtype=np.float64),
+            self._cfg.depth_noise_coefficient,
+        ).reshape(-1)
+
+        if dt > 0.0 and self._tracks:
+            self._predict(dt)
+        for t in self._tracks:
+            t.detection = None
+        free = self._associate(stamp_ns, dets, z, r)
+        self._correct(stamp_ns, dets, z, r)
+        self._create(stamp_ns, dets, z, r, free)
+        if self._cfg.classifier:
+            self._recover(stamp_ns, dets)
+            self._train(dets)
+        self._manage(stamp_ns)
+        return self._outputs(stamp_ns, dets)
+
+    # ------------------------------------------------------------------ steps
+
+    def _select(self, detections: Sequence[Detection]) -> list[Detection]:
+        """Clusters passed to the tracker: all (height-selected) or HOG-selected (Table 7.4)."""
+        size = self._bins**3
+        for d in detections:
+            if not (math.isfinite(d.position[0]) and math.isfinite(d.position[1])):
+                raise ValueError(f"detection position {d.position} is not finite")
+            if not (math.isfinite(d.distance) and d.distance >= 0.0):
+                raise ValueError(f"detection distance={d.distance} must be finite and >= 0")
+            if d.appearance is not None and d.appearance.shape != (size,):
+                raise ValueError(
+                    f"detection appearance has shape {d.appearance.shape}, expected ({size},) "
+                    f"for histogram_bins={self._bins}"
+                )
+        if self._cfg.selection is ClusterSelection.CONFIDENCE:
+            threshold = self._cfg.selection_confidence
+            return [d for d in detections if d.confidence > threshold]
+        return list(detections)
+
+    def _predict(self, dt: float) -> None:
+        Q = process_noise(dt, self._cfg.acceleration_variance)
+        self._x, self._P = ukf.predict(
+            self._x, self._P, lambda X: apply_transition(X, dt), Q, _SIGMA
+        )
+
+    def _associate(self, stamp_ns: int, dets: list[Detection], z: Array, r: Array) -> list[int]:
+        """Steps 1 and 2 of 6.3; marks ``track.detection``; returns the free detections."""
+        free = list(range(len(dets)))
+        if not dets or not self._tracks:
+            return free
+        rows = [i for i, t in enumerate(self._tracks) if not self._dormant(t, stamp_ns)]
+        if rows:
+            idx = np.asarray(rows)
+            z_pred, Pzz, _ = ukf.measurement_prediction(
+                self._x[idx], self._P[idx], apply_measurement, _SIGMA
+            )
+            for i, j in gnn_assign(mahalanobis_sq(z_pred, Pzz, z, r), self._gate):
+                self._tracks[rows[i]].detection = j
+        taken = {t.detection for t in self._tracks if t.detection is not None}
+        free = [j for j in free if j not in taken]
+        if not self._cfg.classifier or not free:
+            return free
+        candidates = [
+            t for t in self._tracks if t.detection is None and self._remembers(t, stamp_ns)
+        ]
+        seen = [j for j in free if dets[j].appearance is not None]
+        if not candidates or not seen:
+            return free
+        hists = np.stack([_appearance(dets[j]) for j in seen])
+        scores = np.stack([_classifier(t).predict(hists) for t in candidates])
+        for i, j in score_assign(scores, self._cfg.min_prediction):
+            candidates[i].detection = seen[j]
+        taken = {t.detection for t in self._tracks if t.detection is not None}
+        return [j for j in free if j not in taken]
+
+    def _correct(self, stamp_ns: int, dets: list[Detection], z: Array, r: Array) -> None:
+        """Filter update of the associated tracks (6.4.2), one batched UKF call."""
+        rows = [i for i, t in enumerate(self._tracks) if t.detection is not None]
+        if not rows:
+            return
+        cols = [_det(self._tracks[i]) for i in rows]
+        idx = np.asarray(rows)
+        R = r[cols][:, None, None] * _EYE2
+        self._x[idx], self._P[idx] = ukf.update(
+            self._x[idx], self._P[idx], z[cols], apply_measurement, R, _SIGMA
+        )
+        for i, j in zip(rows, cols, strict=True):
+            self._mark_seen(self._tracks[i], dets[j], stamp_ns)
+
+    def _mark_seen(self, track: _Track, det: Detection, stamp_ns: int) -> None:
+        track.last_seen_ns = stamp_ns
+        track.height = det.height
+        if det.confidence > self._cfg.min_confidence:
+            track.confident += 1
+            if track.confident >= self._cfg.detections_to_validate:
+                track.validated = True
+
+    def _create(
+        self, stamp_ns: int, dets: list[Detection], z: Array, r: Array, free: list[int]
+    ) -> None:
+        """New tracks from unassociated confident detections (6.4.1, 6.5.4)."""
+        new = [j for j in free if dets[j].confidence > self._cfg.min_confidence]
+        if not new:
+            return
+        x0 = np.zeros((len(new), 4))
+        x0[:, :2] = z[new]
+        P0 = np.zeros((len(new), 4, 4))
+        P0[:, 0, 0] = P0[:, 1, 1] = r[new]
+        P0[:, 2, 2] = P0[:, 3, 3] = self._cfg.initial_velocity_variance
+        self._x = np.concatenate([self._x, x0])
+        self._P = np.concatenate([self._P, P0])
+        for j in new:
+            track_id = self._next_id
+            self._next_id += 1
+            track = _Track(
+                track_id=track_id,
+                created_ns=stamp_ns,
+                last_seen_ns=stamp_ns,
+                confident=0,
+                validated=False,
+                height=dets[j].height,
+                classifier=self._new_classifier(track_id),
+                detection=j,
+            )
+            self._tracks.append(track)
+            self._mark_seen(track, dets[j], stamp_ns)
+
+    def _recover(self, stamp_ns: int, dets: list[Detection]) -> None:
+        """6.4.3: a missing track's classifier claims a still-new track; the old id survives."""
+        young = [
+            i
+            for i, t in enumerate(self._tracks)
+            if t.detection is not None
+            and t.created_ns != stamp_ns
+            and stamp_ns - t.created_ns + STAMP_TOLERANCE_NS < self._new_ns
+            and dets[t.detection].appearance is not None
+        ]
+        if not young:
+            return
+        lost = [
+            i
+            for i, t in enumerate(self._tracks)
+            if t.detection is None and t.validated and self._remembers(t, stamp_ns)
+        ]
+        if not lost:
+            return
+        hists = np.stack([_appearance(dets[_det(self._tracks[i])]) for i in young])
+        scores = np.stack([_classifier(self._tracks[i]).predict(hists) for i in lost])
+        drop: list[int] = []
+        for a, b in score_assign(scores, self._cfg.min_prediction):
+            old, new = self._tracks[lost[a]], self._tracks[young[b]]
+            self._x[lost[a]] = self._x[young[b]]
+            self._P[lost[a]] = self._P[young[b]]
+            old.detection = new.detection
+            old.last_seen_ns = stamp_ns
+            old.height = new.height
+            drop.append(young[b])
+        self._keep([i not in drop for i in range(len(self._tracks))])
+
+    def _train(self, dets: list[Detection]) -> None:
+        """Classifier updates with non-occluded detections only (6.4.2)."""
+        usable = [
+            t
+            for t in self._tracks
+            if t.detection is not None
+            and not dets[t.detection].occluded
+            and dets[t.detection].appearance is not None
+        ]
+        for t in usable:
+            classifier = _classifier(t)
+            classifier.update(_appearance(dets[_det(t)]), True)
+            for other in usable:
+                if other is not t:
+                    classifier.update(_appearance(dets[_det(other)]), False)
+
+    def _manage(self, stamp_ns: int) -> None:
+        """Discard unvalidated tracks past ``frames_before_fake``; drop forgotten ones (6.4.4)."""
+        keep = []
+        for t in self._tracks:
+            age = stamp_ns - t.created_ns + STAMP_TOLERANCE_NS
+            fake = not t.validated and age >= self._fake_ns
+            forgotten = self._dormant(t, stamp_ns) and not self._remembers(t, stamp_ns)
+            keep.append(not fake and not forgotten)
+        self._keep(keep)
+
+    def _outputs(self, stamp_ns: int, dets: list[Detection]) -> list[TrackOutput]:
+        out = []
+        for i, t in enumerate(self._tracks):
+            if self._dormant(t, stamp_ns):
+                continue
+            box: Box2D | None = None
+            visibility = Visibility.NOT_VISIBLE
+            if t.detection is not None:
+                det = dets[t.detection]
+                box = det.box2d
+                visibility = Visibility.OCCLUDED if det.occluded else Visibility.VISIBLE
+            out.append(
+                TrackOutput(
+                    track_id=t.track_id,
+                    x=float(self._x[i, 0]),
+                    y=float(self._x[i, 1]),
+                    height=t.height,
+                    box2d=box,
+                    visibility=visibility,
+                    status=TrackStatus.VALIDATED if t.validated else TrackStatus.NEW,
+                )
+            )
+        out.sort(key=lambda o: o.track_id)
+        return out
+
+    # ------------------------------------------------------------------ helpers
+
+    def _dormant(self, t: _Track, stamp_ns: int) -> bool:
+        """Not visible for ``frames_before_old``: out of the output and of step 1."""
+        missing = stamp_ns - t.last_seen_ns
+        return missing > 0 and missing + STAMP_TOLERANCE_NS >= self._old_ns
+
+    def _remembers(self, t: _Track, stamp_ns: int) -> bool:
+        """The classifier of a missing track is still usable (Figure 7.7)."""
+        if t.classifier is None or t.classifier.positives == 0:
+            return False
+        return stamp_ns - t.last_seen_ns <= self._memory_ns + STAMP_TOLERANCE_NS
+
+    def _keep(self, keep: list[bool]) -> None:
+        if all(keep):
+            return
+        mask = np.asarray(keep, dtype=bool)
+        self._x = self._x[mask]
+        self._P = self._P[mask]
+        self._tracks = [t for t, k in zip(self._tracks, keep, strict=True) if k]
+
+    def _new_classifier(self, track_id: int) -> OnlineBoostingClassifier | None:
+        if not self._cfg.classifier:
+            return None
+        return OnlineBoostingClassifier(
+            self._bins,
+            self._cfg.weak_classifiers,
+            self._cfg.selectors,
+            seed=np.random.SeedSequence([self._cfg.seed, track_id]),
+            learning_rate=self._cfg.classifier_learning_rate,
+        )
+
+
+def _det(track: _Track) -> int:
+    if track.detection is None:
+        raise RuntimeError(f"track {track.track_id} has no detection this frame")
+    return track.detection
+
+
+def _classifier(track: _Track) -> OnlineBoostingClassifier:
+    if track.classifier is None:
+        raise RuntimeError(f"track {track.track_id} has no classifier")
+    return track.classifier
+
+
+def _appearance(det: Detection) -> NDArray[np.float32]:
+    if det.appearance is None:
+        raise RuntimeError("detection without appearance used for classification")
+    return det.appearance

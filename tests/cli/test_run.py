@@ -1,0 +1,92 @@
+"""`rgbd-eval run` on small recordings: outputs, scoring paths, errors and exit codes."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from rgbd_eval.cli.main import app
+from rgbd_eval.io.groundtruth import write_csv
+from rgbd_eval.types import Box2D, GroundTruthObject
+from tests.io.conftest import PERIOD, T0, Spec, write_recording
+
+runner = CliRunner()
+
+
+def test_unscored_run_writes_outputs(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "nogt.mcap", "mcap", Spec(n=4, ground_truth=False))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["run", str(rec), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "no ground truth found; nothing scored" in result.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["schema_version"] == 1 and report["overall"] is None
+    seq = report["sequences"][0]
+    assert seq["scored"] is False and seq["frames"] == 4 and len(seq["sha256"]) == 64
+    assert report["config"]["tracker"]["min_confidence"] == -0.5
+    for name in ("nogt.tracks.csv", "nogt.detections.csv", "nogt.birdseye.png", "report.md"):
+        assert (out / name).stat().st_size > 0
+    assert (
+        (out / "nogt.tracks.csv")
+        .read_text()
+        .startswith("frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z")
+    )
+
+
+def test_scored_run_counts_every_ground_truth_instance(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "withgt.mcap", "mcap", Spec(n=5))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["run", str(rec), "--out", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.output)
+    counts = report["sequences"][0]["counts"]
+    # One annotated person in each of the 5 frames: every instance is a match or a miss.
+    assert counts["num_gt"] == 5
+    assert counts["num_matches"] + counts["fn"] == 5
+    assert report["overall"]["counts"] == counts
+
+
+def test_gating_needs_matching_ground_truth(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "boxes.mcap", "mcap", Spec(n=3, ground_truth=False))
+    gt = tmp_path / "boxes_only.csv"
+    write_csv(
+        gt, [GroundTruthObject(i, T0 + i * PERIOD, 1, Box2D(1, 1, 5, 20), None) for i in range(3)]
+    )
+    out = tmp_path / "out"
+    result = runner.invoke(
+        app, ["run", str(rec), "--gt", str(gt), "--gating", "metric", "--out", str(out)]
+    )
+    assert result.exit_code == 6, result.output
+    assert "'metric' gating needs world positions" in result.output
+    assert not out.exists()  # a failed run leaves no report behind
+
+
+def test_bad_ground_truth_and_bad_config(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "r.mcap", "mcap", Spec(n=2, ground_truth=False))
+    bad = tmp_path / "bad.csv"
+    bad.write_text("frame,id\n")
+    result = runner.invoke(app, ["run", str(rec), "--gt", str(bad), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 5 and "missing columns" in result.output
+    result = runner.invoke(
+        app, ["run", str(rec), "--set", "tracker.nope=1", "--out", str(tmp_path / "o")]
+    )
+    assert result.exit_code == 4 and "unknown key 'nope'" in result.output
+    result = runner.invoke(app, ["run", str(rec), "--gating", "both", "--out", str(tmp_path / "o")])
+    assert result.exit_code == 4 and "evaluation.gating" in result.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_folder_of_recordings_gives_overall_row(tmp_path: Path) -> None:
+    data = tmp_path / "data"
+    write_recording(data / "a.mcap", "mcap", Spec(n=2))
+    write_recording(data / "b.bag", "ros1", Spec(n=3))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["run", str(data), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    report = json.loads((out / "report.json").read_text())
+    assert [s["name"] for s in report["sequences"]] == ["a", "b"]
+    # Overall counts are sums, never averages of ratios.
+    assert report["overall"]["counts"]["num_gt"] == 5
+    assert "overall" in (out / "report.md").read_text()
