@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 
 from rgbd_eval import __version__
+from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.run import run
 
@@ -17,6 +18,7 @@ app = typer.Typer(
 )
 app.command("run")(run)
 app.command("inspect")(inspect)
+app.command("compare")(compare)
 
 
 def _version(value: bool) -> None:

@@ -1,0 +1,63 @@
+"""``rgbd-eval compare``: gate regressions between two reports (exit 1 on regression)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from rgbd_eval.atomic import write_text
+from rgbd_eval.cli.common import console, handle_errors
+from rgbd_eval.compare import (
+    HEADER,
+    Status,
+    compare_reports,
+    load_report,
+    markdown,
+    parse_tolerances,
+    table_rows,
+)
+
+
+@handle_errors
+def compare(
+    baseline: Annotated[Path, typer.Argument(help="baseline report.json (or its run folder)")],
+    current: Annotated[Path, typer.Argument(help="current report.json (or its run folder)")],
+    tolerance: Annotated[
+        list[str] | None,
+        typer.Option("--tolerance", help="METRIC=VALUE allowed worsening, repeatable"),
+    ] = None,
+    markdown_file: Annotated[
+        Path | None, typer.Option("--markdown", help="also write the table as Markdown")
+    ] = None,
+    all_rows: Annotated[bool, typer.Option("--all", help="show unchanged metrics too")] = False,
+) -> None:
+    """Per sequence and overall, what got better and what got worse; exit 1 on regression."""
+    tolerances = parse_tolerances(tolerance or [])  # bad arguments fail before any file is read
+    comparison = compare_reports(load_report(baseline), load_report(current), tolerances)
+    table = Table(title=f"{baseline} -> {current}", title_justify="left")
+    for i, head in enumerate(HEADER):
+        table.add_column(head, justify="left" if i < 2 else "right")
+    styles = {
+        Status.REGRESSED.value: "bold red",
+        Status.WORSE.value: "yellow",
+        Status.BETTER.value: "green",
+    }
+    rows = table_rows(comparison, changed_only=not all_rows)
+    for row in rows:
+        table.add_row(*row, style=styles.get(row[-1]))
+    if rows:
+        console.print(table)
+    for change in comparison.config_changes:
+        console.print(f"config: {change}")
+    if markdown_file is not None:
+        write_text(markdown_file, markdown(comparison))
+    if comparison.regressions:
+        names = ", ".join(f"{d.sequence}/{d.metric}" for d in comparison.regressions)
+        console.print(
+            f"[bold red]{len(comparison.regressions)} regression(s) beyond tolerance:[/] {names}"
+        )
+        raise typer.Exit(1)
+    console.print("no regression beyond tolerance")
