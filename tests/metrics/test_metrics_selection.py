@@ -22,11 +22,10 @@ def test_tracks_on_ignored_takes_the_most_pairs() -> None:
     assert tracks_on_ignored(ignored, tracks, Gating.IOU, 0.5) == [0, 1]
 
 
-def test_tracks_on_ignored_prefers_two_pairs_to_one_closer_pair() -> None:
-    # On the ground: ignored at 0 m and 1.8 m; tracks at 0.9 m and 0.0 m.
-    # Min-cost alone could pair 0 m with the track at 0.0 m (0 m) and leave 1.8 m
-    # unpaired (0.9 m away is still inside the 1 m gate) -- both pairings use two
-    # pairs here: 0-0.0 (0) + 1.8-0.9 (0.9) = 0.9.
+def test_tracks_on_ignored_pairs_as_many_as_possible() -> None:
+    # On the ground: ignored I1 at 0 m, I2 at 1.8 m; tracks T0 at 0.9 m, T1 at 0.0 m.
+    # Inside the 1 m gate: I1-T0 0.9, I1-T1 0.0, I2-T0 0.9 (I2-T1 is 1.8 m: out).
+    # Two pairs exist only as I1-T1 + I2-T0 (0.0 + 0.9): both tracks are dropped.
     ignored = np.array([(0.0, 0.0), (1.8, 0.0)])
     tracks = np.array([(0.9, 0.0), (0.0, 0.0)])
     assert tracks_on_ignored(ignored, tracks, Gating.METRIC, 1.0) == [0, 1]

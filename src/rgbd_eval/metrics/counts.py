@@ -1,8 +1,8 @@
 """Summable CLEAR MOT counts and the one place where ratios are derived from them.
 
-:class:`Counts` holds only integer counts and one float sum, so that the counts of
-several sequences add up exactly; the overall score is ``summarize(total(...))``,
-never an average of per-sequence ratios.
+:class:`Counts` holds integer counts and one float sum, so that the counts of
+several sequences add up; the overall score is ``summarize(total(...))``, never an
+average of per-sequence ratios.
 
 Derived measures (:func:`summarize`), with ``GT`` the number of scored
 ground-truth instances:
