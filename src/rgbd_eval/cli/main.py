@@ -8,6 +8,7 @@ from rgbd_eval import __version__
 from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.run import run
+from rgbd_eval.cli.sweep_cmd import sweep
 
 app = typer.Typer(
     name="rgbd-eval",
@@ -17,6 +18,7 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 app.command("run")(run)
+app.command("sweep")(sweep)
 app.command("inspect")(inspect)
 app.command("compare")(compare)
 

@@ -1,0 +1,76 @@
+"""Sweeps: grid expansion and validation, the detection cache, equality with separate runs."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rgbd_eval.cache import DetectionCache, detection_key
+from rgbd_eval.config import build_config, load_config
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.pipeline import run_sequence
+from rgbd_eval.report import file_digest
+from rgbd_eval.sweep import SweepParam, expand_grid, parse_param, point_configs, run_sweep
+from tests.io.conftest import Spec, write_recording
+
+
+def test_grid_expansion_order_and_parsing() -> None:
+    p = parse_param("tracker.min_confidence=-1,-0.5")
+    assert p == SweepParam("tracker.min_confidence", (-1, -0.5))
+    grid = expand_grid([p, SweepParam("tracker.classifier", (True, False))])
+    # First parameter slowest: 2 x 2 points.
+    assert grid == [
+        {"tracker.min_confidence": -1, "tracker.classifier": True},
+        {"tracker.min_confidence": -1, "tracker.classifier": False},
+        {"tracker.min_confidence": -0.5, "tracker.classifier": True},
+        {"tracker.min_confidence": -0.5, "tracker.classifier": False},
+    ]
+    with pytest.raises(ConfigError, match="swept twice"):
+        expand_grid([p, p])
+    with pytest.raises(ConfigError, match="expected NAME=V1,V2"):
+        parse_param("tracker.min_confidence")
+
+
+def test_every_point_is_validated_before_running() -> None:
+    base = load_config(method="basso2012").model_dump(mode="json")
+    grid = expand_grid([SweepParam("tracker.selectors", (10, 400))])
+    with pytest.raises(
+        ConfigError, match=r"sweep point tracker.selectors=400.*selectors=400 must not exceed"
+    ):
+        point_configs(base, [], grid)
+    with pytest.raises(ConfigError, match="unknown key 'nope'"):
+        point_configs(base, [], expand_grid([SweepParam("tracker.nope", (1,))]))
+
+
+def test_cache_hit_and_invalidation(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=4))
+    cache = tmp_path / "cache"
+    base = load_config(method="basso2012").model_dump(mode="json")
+    grid = expand_grid([SweepParam("tracker.min_confidence", (-1.0, 0.0))])
+    configs = point_configs(base, [], grid)
+    first = run_sweep([rec], grid, configs, cache_root=cache)
+    # Two tracker values share one detector config: one detection pass, a miss.
+    assert (first.cache_hits, first.cache_misses) == (0, 1)
+    second = run_sweep([rec], grid, configs, cache_root=cache)
+    assert (second.cache_hits, second.cache_misses) == (1, 0)
+    assert [r.counts for r in second.records] == [r.counts for r in first.records]
+    # A detector change or a different recording is a different key.
+    digest = file_digest(rec)
+    other_detector = build_config(base, [("detector.voxel_size", 0.08)])
+    assert detection_key(digest, other_detector) != detection_key(digest, configs[0])
+    rec2 = write_recording(tmp_path / "b.mcap", "mcap", Spec(n=5))
+    assert detection_key(file_digest(rec2), configs[0]) != detection_key(digest, configs[0])
+    assert DetectionCache(cache).load(detection_key(file_digest(rec2), configs[0])) is None
+
+
+def test_sweep_points_equal_separate_runs(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=6))
+    base = load_config(method="basso2012").model_dump(mode="json")
+    grid = expand_grid([SweepParam("tracker.min_confidence", (-1.0, 0.5))])
+    configs = point_configs(base, [], grid)
+    result = run_sweep([rec], grid, configs, cache_root=tmp_path / "cache", jobs=2)
+    for record, config in zip(result.records, configs, strict=True):
+        single = run_sequence(rec, config)
+        assert single.scores is not None
+        assert record.counts == single.scores.counts
