@@ -202,7 +202,7 @@ class TrackerConfig(_Model):
     selection_confidence: float = Field(
         -3.0, description="HOG threshold when selection is 'confidence' (7.3)"
     )
-    seed: int = Field(0, description="seed of the classifier's random features")
+    seed: int = Field(0, ge=0, description="seed of the classifier's random features")
     initial_velocity_variance: float = Field(
         1.0,
         gt=0.0,

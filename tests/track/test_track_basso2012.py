@@ -6,8 +6,10 @@ from collections.abc import Iterable
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from rgbd_eval.config import ClusterSelection, RunConfig, TrackerConfig
+from rgbd_eval.config import ClusterSelection, RunConfig, TrackerConfig, build_config
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.track import create_tracker, known_trackers
 from rgbd_eval.track.basso2012 import Basso2012Tracker
@@ -71,8 +73,11 @@ def test_bad_detections_and_seed_raise() -> None:
     with pytest.raises(ValueError, match="distance=inf"):
         t.update(2, [Detection(far.position, 1.7, 0.0, far.box2d, distance=float("inf"))])
     t.update(3, [])  # the failed calls consumed no stamp
-    with pytest.raises(ConfigError, match="tracker.seed=-1"):
-        _tracker(seed=-1)
+    # A negative seed is refused by the config itself, before a tracker exists.
+    with pytest.raises(
+        ConfigError, match=r"tracker\.seed: Input should be greater than or equal to 0"
+    ):
+        build_config({"tracker": {"seed": -1}})
 
 
 def test_empty_frames_give_no_tracks() -> None:
@@ -259,3 +264,74 @@ def test_same_input_same_output_bit_for_bit() -> None:
     a = _run(_tracker(seed=4), frames)
     b = _run(_tracker(seed=4), frames)
     assert a == b
+
+
+def _jump_stream() -> list[list[Detection]]:
+    """Red and blue stand still for 2 s; then red jumps 2.5 m sideways in one frame."""
+    rng = np.random.default_rng(2)
+    out = []
+    for k in range(90):
+        red_y = 1.0 if k < 60 else 3.5
+        out.append(
+            [
+                person_detection(3.0, -1.0, histogram=colour_histogram(rng, BLUE)),
+                person_detection(3.0, red_y, histogram=colour_histogram(rng, RED)),
+            ]
+        )
+    return out
+
+
+def test_classifier_step_associates_a_detection_outside_the_gate() -> None:
+    # 6.3 second step: the jump is far outside the 0.999 gate, the red classifier
+    # (score above min_prediction) keeps the id; without classifier a new track starts
+    frames = _jump_stream()
+    with_c = _run(_tracker(), frames)
+    without = _run(_tracker(classifier=False), frames)
+    red = _id_near(with_c[59], 1.0)
+    assert red is not None
+    assert [_id_near(f, 3.5) for f in with_c[60:]] == [red] * 30
+    assert _id_near(without[60], 3.5) not in (None, _id_near(without[59], 1.0))
+
+
+@settings(max_examples=10, deadline=None)
+@given(
+    st.lists(
+        st.lists(
+            st.tuples(
+                st.floats(0.5, 6.0),
+                st.floats(-3.0, 3.0),
+                st.sampled_from([-100.0, -1.0, 0.5]),
+                st.booleans(),
+            ),
+            max_size=4,
+        ),
+        min_size=1,
+        max_size=25,
+    ),
+    st.booleans(),
+)
+def test_output_invariants(
+    frames_spec: list[list[tuple[float, float, float, bool]]], classifier: bool
+) -> None:
+    rng = np.random.default_rng(0)
+    frames = [
+        [
+            person_detection(
+                x, y, confidence=c, occluded=o, histogram=colour_histogram(rng, RED, pixels=50)
+            )
+            for x, y, c, o in spec
+        ]
+        for spec in frames_spec
+    ]
+    out = _run(_tracker(classifier=classifier), frames)
+    assert out == _run(_tracker(classifier=classifier), frames)  # deterministic
+    validated: set[int] = set()
+    for frame, dets in zip(out, frames, strict=True):
+        ids = _ids(frame)
+        assert ids == sorted(set(ids))
+        assert sum(o.visibility is not Visibility.NOT_VISIBLE for o in frame) <= len(dets)
+        for o in frame:
+            assert (o.box2d is None) == (o.visibility is Visibility.NOT_VISIBLE)
+            assert o.track_id not in validated or o.status is TrackStatus.VALIDATED
+            if o.status is TrackStatus.VALIDATED:
+                validated.add(o.track_id)

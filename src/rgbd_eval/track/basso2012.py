@@ -4,7 +4,8 @@ Per frame, in the world frame of odometry (6.5.1):
 
 1. predict every track with the constant-velocity UKF over the stamp difference (6.1, 6.5.2);
 2. associate tracks and detections by gated Mahalanobis distance, Hungarian method (6.3);
-3. associate the leftovers by classifier score above ``min_prediction`` (6.3);
+3. associate the leftovers by classifier score above ``min_prediction`` (6.3); these
+   tracks restart their filter at the detection, which their motion model missed;
 4. update the filters with the theoretical centroids, and the classifiers with the
    non-occluded detections: own detection positive, other tracks' negative (6.2.2, 6.4.2);
 5. create tracks from leftover detections with HOG confidence above ``min_confidence``,
@@ -17,7 +18,14 @@ Per frame, in the world frame of odometry (6.5.1):
 
 Frame counts are turned into seconds at ``reference_rate_hz`` and compared with
 stamp differences, so dropped frames and other rates keep their meaning in time.
-The output height is the last associated detection's height.
+
+Choices the thesis leaves open: the innovation covariance of a pair is the track's
+predicted measurement covariance plus the detection's own noise (6.7 makes ``R``
+depend on the detection's distance); new (unvalidated) tracks are output with
+status NEW; only validated tracks are recovery targets; the training negatives of a
+track are the non-occluded detections of the other tracks of the frame, learned
+after its positive, in track order; the output height is the last associated
+detection's height.
 """
 
 from __future__ import annotations
@@ -30,7 +38,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.config import ClusterSelection, RunConfig
-from rgbd_eval.errors import ConfigError
 from rgbd_eval.track import ukf
 from rgbd_eval.track.association import (
     chi_square_gate,
@@ -55,6 +62,7 @@ STAMP_TOLERANCE_NS = 1_000_000
 
 _SIGMA = ukf.sigma_weights(4)
 _EYE2 = np.eye(2)
+_EMPTY = np.zeros(0)
 
 
 def _ns(seconds: float) -> int:
@@ -73,6 +81,7 @@ class _Track:
     height: float
     classifier: OnlineBoostingClassifier | None
     detection: int | None = None  # index into this frame's detections, or None
+    by_classifier: bool = False  # this frame's detection came from the classifier step
 
 
 @register_tracker("basso2012")
@@ -81,8 +90,6 @@ class Basso2012Tracker:
 
     def __init__(self, config: RunConfig) -> None:
         cfg = config.tracker
-        if cfg.seed < 0:
-            raise ConfigError(f"tracker.seed={cfg.seed} must be >= 0")
         self._cfg = cfg
         self._bins = config.detector.histogram_bins
         self._voxel = config.detector.voxel_size
@@ -99,6 +106,8 @@ class Basso2012Tracker:
         self._x = np.zeros((0, 4))
         self._P = np.zeros((0, 4, 4))
         self._tracks: list[_Track] = []
+        # step 1's measurement prediction: rows, z_hat, Pzz, Pxz (reused by the update)
+        self._prediction: tuple[list[int], Array, Array, Array] = ([], _EMPTY, _EMPTY, _EMPTY)
         self._last_ns: int | None = None
         self._next_id = 1
 
@@ -122,6 +131,7 @@ class Basso2012Tracker:
             self._predict(dt)
         for t in self._tracks:
             t.detection = None
+            t.by_classifier = False
         free = self._associate(stamp_ns, dets, z, r)
         self._correct(stamp_ns, dets, z, r)
         self._create(stamp_ns, dets, z, r, free)
@@ -160,14 +170,16 @@ class Basso2012Tracker:
     def _associate(self, stamp_ns: int, dets: list[Detection], z: Array, r: Array) -> list[int]:
         """Steps 1 and 2 of 6.3; marks ``track.detection``; returns the free detections."""
         free = list(range(len(dets)))
+        self._prediction = ([], _EMPTY, _EMPTY, _EMPTY)
         if not dets or not self._tracks:
             return free
         rows = [i for i, t in enumerate(self._tracks) if not self._dormant(t, stamp_ns)]
         if rows:
             idx = np.asarray(rows)
-            z_pred, Pzz, _ = ukf.measurement_prediction(
+            z_pred, Pzz, Pxz = ukf.measurement_prediction(
                 self._x[idx], self._P[idx], apply_measurement, _SIGMA
             )
+            self._prediction = (rows, z_pred, Pzz, Pxz)
             for i, j in gnn_assign(mahalanobis_sq(z_pred, Pzz, z, r), self._gate):
                 self._tracks[rows[i]].detection = j
         taken = {t.detection for t in self._tracks if t.detection is not None}
@@ -184,22 +196,47 @@ class Basso2012Tracker:
         scores = np.stack([_classifier(t).predict(hists) for t in candidates])
         for i, j in score_assign(scores, self._cfg.min_prediction):
             candidates[i].detection = seen[j]
+            candidates[i].by_classifier = True
         taken = {t.detection for t in self._tracks if t.detection is not None}
         return [j for j in free if j not in taken]
 
     def _correct(self, stamp_ns: int, dets: list[Detection], z: Array, r: Array) -> None:
-        """Filter update of the associated tracks (6.4.2), one batched UKF call."""
+        """Filter update of the associated tracks (6.4.2), one batched UKF call.
+
+        A track associated by its classifier (step 2) restarts its filter at the
+        detection: the detection fell outside the motion model's gate, or the track
+        was lost, so its prediction is not to be blended with the measurement.
+        """
         rows = [i for i, t in enumerate(self._tracks) if t.detection is not None]
         if not rows:
             return
-        cols = [_det(self._tracks[i]) for i in rows]
-        idx = np.asarray(rows)
-        R = r[cols][:, None, None] * _EYE2
-        self._x[idx], self._P[idx] = ukf.update(
-            self._x[idx], self._P[idx], z[cols], apply_measurement, R, _SIGMA
-        )
-        for i, j in zip(rows, cols, strict=True):
-            self._mark_seen(self._tracks[i], dets[j], stamp_ns)
+        restart = [i for i in rows if self._tracks[i].by_classifier]
+        if restart:
+            cols = [_det(self._tracks[i]) for i in restart]
+            self._x[restart], self._P[restart] = self._initial_state(z[cols], r[cols])
+        update = [i for i in rows if i not in restart]
+        if update:
+            # every Kalman-associated track was predicted in step 1: reuse that prediction
+            predicted, z_pred, Pzz, Pxz = self._prediction
+            k = np.searchsorted(predicted, update)
+            cols = [_det(self._tracks[i]) for i in update]
+            idx = np.asarray(update)
+            R = r[cols][:, None, None] * _EYE2
+            self._x[idx], self._P[idx] = ukf.correct(
+                self._x[idx], self._P[idx], z[cols], z_pred[k], Pzz[k], Pxz[k], R
+            )
+        for i in rows:
+            t = self._tracks[i]
+            self._mark_seen(t, dets[_det(t)], stamp_ns)
+
+    def _initial_state(self, z: Array, r: Array) -> tuple[Array, Array]:
+        """State at rest on the measurements, velocity variance from the config."""
+        x0 = np.zeros((len(z), 4))
+        x0[:, :2] = z
+        P0 = np.zeros((len(z), 4, 4))
+        P0[:, 0, 0] = P0[:, 1, 1] = r
+        P0[:, 2, 2] = P0[:, 3, 3] = self._cfg.initial_velocity_variance
+        return x0, P0
 
     def _mark_seen(self, track: _Track, det: Detection, stamp_ns: int) -> None:
         track.last_seen_ns = stamp_ns
@@ -216,11 +253,7 @@ class Basso2012Tracker:
         new = [j for j in free if dets[j].confidence > self._cfg.min_confidence]
         if not new:
             return
-        x0 = np.zeros((len(new), 4))
-        x0[:, :2] = z[new]
-        P0 = np.zeros((len(new), 4, 4))
-        P0[:, 0, 0] = P0[:, 1, 1] = r[new]
-        P0[:, 2, 2] = P0[:, 3, 3] = self._cfg.initial_velocity_variance
+        x0, P0 = self._initial_state(z[new], r[new])
         self._x = np.concatenate([self._x, x0])
         self._P = np.concatenate([self._P, P0])
         for j in new:

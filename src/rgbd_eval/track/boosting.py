@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.linalg import blas
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -135,20 +136,31 @@ class OnlineBoostingClassifier:
         return self._selected.copy()
 
     @property
+    def boxes(self) -> IntArray:
+        """The weak hypotheses' parallelepipeds ``(weak_classifiers, 3, 2)`` (a copy)."""
+        return self._boxes.copy()
+
+    @property
     def alpha(self) -> Array:
         """Votes of the selectors (a copy)."""
         return self._alpha.copy()
 
     def features(self, histograms: Histograms) -> Array:
-        """Feature values ``(..., weak_classifiers)`` of histograms ``(..., bins**3)``."""
-        return self._box_sums(self._check(histograms), self._corners)
+        """Feature values ``(weak_classifiers,)`` or ``(D, weak_classifiers)`` of histograms."""
+        h = self._check(histograms)
+        if h.ndim == 2:
+            return np.stack([self._box_sums(row, self._corners) for row in h])
+        return self._box_sums(h, self._corners)
 
     def predict(self, histograms: Histograms) -> Array:
-        """Confidence ``H(x)`` for one histogram ``(bins**3,)`` or a batch ``(D, bins**3)``."""
-        sel = self._selected
-        f = self._box_sums(self._check(histograms), self._corners[sel])
-        says_pos = self._hypotheses(f, sel)
-        return np.asarray(np.where(says_pos, 1.0, -1.0) @ self._alpha, dtype=np.float64)
+        """Confidence ``H(x)`` for one histogram ``(bins**3,)`` or a batch ``(D, bins**3)``.
+
+        A batch gives exactly the values of its rows one by one.
+        """
+        h = self._check(histograms)
+        if h.ndim == 2:
+            return np.array([self._confidence(row) for row in h])
+        return np.asarray(self._confidence(h), dtype=np.float64)
 
     def update(self, histogram: Histograms, positive: bool) -> None:
         """Learn one labelled sample (importance 1)."""
@@ -169,10 +181,15 @@ class OnlineBoostingClassifier:
 
     # ------------------------------------------------------------------ internals
 
+    def _confidence(self, h: Array) -> float:
+        sel = self._selected
+        says_pos = self._hypotheses(self._box_sums(h, self._corners[sel]), sel)
+        return float(np.where(says_pos, 1.0, -1.0) @ self._alpha)
+
     def _box_sums(self, h: Array, corners: IntArray) -> Array:
-        """Histogram mass in boxes given by corners: the same arithmetic for any batch size."""
+        """Mass of one histogram ``(bins**3,)`` in the boxes given by their corners."""
         cum = integral_histograms(h, self.bins)
-        return np.asarray((cum[..., corners] * CORNER_SIGNS).sum(axis=-1), dtype=np.float64)
+        return np.asarray(cum.take(corners) @ CORNER_SIGNS, dtype=np.float64)
 
     def _check(self, histograms: Histograms) -> Array:
         h = np.asarray(histograms, dtype=np.float64)
@@ -192,22 +209,22 @@ class OnlineBoostingClassifier:
 
     def _boost(self, correct: NDArray[np.bool_]) -> None:
         """Selectors in turn: weigh the pool, take the best free hypothesis, pass lambda on."""
-        N, M = self._wrong.shape
+        N = self._wrong.shape[0]
         miss = (~correct).astype(np.float64)
         is_correct = correct.tolist()
-        work = self._wrong.copy()  # taken hypotheses become inf for the later selectors
+        # scratch copy: row n becomes the wrong weights after this sample; hypotheses taken
+        # by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact in any order.
+        work = self._wrong.copy()
         rows = list(work)
-        buf = np.empty(M)
         chosen = [0] * N
         errors = [0.0] * N
         lams = [0.0] * N
         total = self._total.tolist()
         lam = 1.0
         for n in range(N):  # Oza's importance recursion; each step vectorised over the pool
-            np.multiply(miss, lam, out=buf)
-            buf += rows[n]  # the wrong weights after this sample
-            m = int(buf.argmin())
-            e = float(buf[m]) / (total[n] + lam)
+            row = blas.daxpy(miss, rows[n], a=lam)  # in place: row += lam * miss
+            m = int(row.argmin())
+            e = float(row[m]) / (total[n] + lam)
             work[n + 1 :, m] = np.inf
             chosen[n], errors[n], lams[n] = m, e, lam
             lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)

@@ -93,6 +93,13 @@ def update(
 ) -> tuple[Array, Array]:
     """Posterior ``(x, P)`` given measurement ``z`` with additive noise ``R``."""
     z_hat, Pzz, Pxz = measurement_prediction(x, P, hx, w)
+    return correct(x, P, z, z_hat, Pzz, Pxz, R)
+
+
+def correct(
+    x: Array, P: Array, z: Array, z_hat: Array, Pzz: Array, Pxz: Array, R: Array
+) -> tuple[Array, Array]:
+    """Posterior from a :func:`measurement_prediction` already made (``S = Pzz + R``)."""
     S = Pzz + R
     # K = Pxz S^-1, solved as S^T K^T = Pxz^T (S is symmetric)
     K = np.swapaxes(np.linalg.solve(S, np.swapaxes(Pxz, -1, -2)), -1, -2)
