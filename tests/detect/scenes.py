@@ -48,6 +48,10 @@ class Scene:
     blocks: list[Block] = field(default_factory=list)
     floor_colour: tuple[int, int, int] = (170, 170, 160)
     wall_x: float | None = 9.0
+    #: A side wall at world y = side_wall_y (the plane x-z), 2.6 m tall.
+    side_wall_y: float | None = None
+    #: A ceiling at this height over the whole floor.
+    ceiling: float | None = None
 
 
 def camera_pose(
@@ -138,6 +142,15 @@ def render(
     if scene.wall_x is not None:
         wall = _box(scene.wall_x + 0.05, 0.0, 0.0, 0.1, 60.0, 3.0)
         colours[rc.add_triangles(_mesh(wall))] = (200, 200, 210)
+    if scene.side_wall_y is not None:
+        side = _box(0.0, scene.side_wall_y + np.sign(scene.side_wall_y) * 0.05, 0.0, 60.0, 0.1, 2.6)
+        colours[rc.add_triangles(_mesh(side))] = (190, 200, 190)
+    if scene.ceiling is not None:
+        colours[rc.add_triangles(_mesh(_box(0.0, 0.0, scene.ceiling, 60.0, 60.0, 0.1)))] = (
+            230,
+            230,
+            230,
+        )
     for p in scene.people:
         for mesh, colour in person_parts(p):
             colours[rc.add_triangles(_mesh(mesh))] = colour

@@ -108,6 +108,43 @@ def test_three_people_walking_in_a_row_abreast() -> None:
         _assert_person(best, p)
 
 
+@pytest.mark.parametrize(
+    ("people", "size"),
+    [
+        # Shoulder to shoulder, heads 0.4 m apart, at 160x120.
+        ([Person(3.5, 0.2, 1.75), Person(3.5, -0.2, 1.72)], (160, 120)),
+        # Diagonal, 0.36 m apart on the ground, one partly behind the other.
+        ([Person(3.0, 0.0, 1.75), Person(3.3, 0.2, 1.70)], (160, 120)),
+        # Side by side at 6 m.
+        ([Person(6.0, 0.22, 1.75), Person(6.0, -0.23, 1.72)], (160, 120)),
+        # Facing each other, talking.
+        ([Person(3.5, 0.2, 1.75, yaw=-1.57), Person(3.5, -0.2, 1.68, yaw=1.57)], (320, 240)),
+        # Three abreast, 0.42 m apart.
+        ([Person(4.0, 0.42, 1.7), Person(4.0, 0.0, 1.8), Person(4.0, -0.42, 1.65)], (320, 240)),
+    ],
+)
+def test_close_groups_come_out_as_separate_people(
+    people: list[Person], size: tuple[int, int]
+) -> None:
+    dets = _detect(render(Scene(people=people), camera_pose(height=1.0), size))
+    assert len(dets) == len(people)
+    for p in people:
+        best = min(dets, key=lambda d: np.hypot(d.position[0] - p.x, d.position[1] - p.y))
+        _assert_person(best, p)
+
+
+def test_pair_in_a_corridor_under_a_ceiling() -> None:
+    # One person's shoulder touches the side wall (one Euclidean cluster with the wall
+    # and, through the corner, the ceiling seen above them): both still come out.
+    people = [Person(4.0, 0.55, 1.75), Person(4.0, 0.1, 1.70)]
+    scene = Scene(people=people, side_wall_y=0.9, ceiling=2.7)
+    dets = _detect(render(scene, camera_pose(height=1.0)))
+    assert len(dets) == 2
+    for p in people:
+        best = min(dets, key=lambda d: np.hypot(d.position[0] - p.x, d.position[1] - p.y))
+        _assert_person(best, p)
+
+
 def test_person_behind_an_obstacle_is_kept_and_flagged_occluded() -> None:
     # A 1 m tall box 0.8 m in front hides the legs: occluded, still detected, and not
     # visible top to bottom, so the thesis' default confidence -100 (5.4.2).

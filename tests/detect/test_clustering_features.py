@@ -55,6 +55,18 @@ def test_merge_close_clusters_joins_head_and_body() -> None:
     assert merge_close_clusters(xy, labels, 0.3).tolist() == [0, 0, 0, 0, 1, 1]
 
 
+def test_merge_leaves_out_tall_and_wide_pieces() -> None:
+    # Cluster 0: a 0.2 m piece, centre (0, 0); cluster 1: a ceiling-like piece whose
+    # centre (0.1, 0) is close but which spans 4 m (wider than a person, 1 m) and
+    # is 2.7 m high (above max_height 2.3): they are not merged. Cluster 2, a small
+    # piece at (0.2, 0), 1.5 m high, is merged with cluster 0.
+    xy = np.array([[-0.1, 0], [0.1, 0], [-1.9, 0], [2.1, 0], [0.2, 0], [0.2, 0.05]])
+    heights = np.array([1.0, 1.0, 2.7, 2.7, 1.5, 1.5])
+    labels = np.array([0, 0, 1, 1, 2, 2])
+    merged = merge_close_clusters(xy, labels, 0.3, heights, 2.3)
+    assert merged.tolist() == [0, 0, 1, 1, 0, 0]
+
+
 # ---------------------------------------------------------------- head sub-clustering
 
 
@@ -180,3 +192,34 @@ def test_blob_pixels_cover_each_points_footprint() -> None:
     assert sorted(set(cols.tolist())) == [1, 2, 3]
     assert sorted(set(rows.tolist())) == [2, 3, 4]
     assert px.shape[0] == 9
+
+
+def test_person_next_to_a_wall_is_split_from_it() -> None:
+    # A wall line at y = 0.4 m, 2.6 m tall and 2 m long (above max_height 2.3: a
+    # tall seed), with a person at the origin whose shoulders touch it.
+    p_xy, p_h = _person_cloud(0.0, 0.0, 1.75)
+    wx = np.arange(-1.0, 1.0, 0.03)
+    w_xy = np.column_stack([np.concatenate([wx] * 41), np.full(41 * wx.size, 0.4)])
+    w_h = np.repeat(np.linspace(0.2, 2.6, 41), wx.size)  # 6 cm apart, as voxels
+    xy, h = np.vstack([p_xy, w_xy]), np.concatenate([p_h, w_h])
+    labels = split_by_heads(xy, h, np.zeros(len(h), dtype=np.int64), 0.06, 0.3, 0.1, (1.4, 2.3))
+    person, wall = labels[: len(p_h)], labels[len(p_h) :]
+    assert len(set(person.tolist())) == 1 and len(set(wall.tolist())) == 1
+    assert person[0] != wall[0]
+
+
+def test_overhanging_ceiling_does_not_hide_the_person() -> None:
+    # A ceiling at 2.7 m over the person (no points between 1.75 and 2.7 in those
+    # cells): the head is still found and the ceiling points belong to no one.
+    p_xy, p_h = _person_cloud(0.0, 0.0, 1.75)
+    g = np.arange(-0.6, 0.6, 0.05)
+    cx, cy = np.meshgrid(g, g)
+    c_xy = np.column_stack([cx.ravel(), cy.ravel()])
+    c_h = np.full(c_xy.shape[0], 2.7)
+    xy, h = np.vstack([p_xy, c_xy]), np.concatenate([p_h, c_h])
+    heads = find_heads(xy, h, 0.06, 0.3, 0.1, (1.4, 2.3))
+    assert heads.shape == (1, 2)
+    np.testing.assert_allclose(heads[0], [0.0, 0.0], atol=0.06)
+    labels = split_by_heads(xy, h, np.zeros(len(h), dtype=np.int64), 0.06, 0.3, 0.1, (1.4, 2.3))
+    assert set(labels[: len(p_h)].tolist()) == {0}
+    assert set(labels[len(p_h) :].tolist()) == {-1}

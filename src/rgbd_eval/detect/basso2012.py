@@ -171,7 +171,10 @@ class Basso2012Detector:
         clock.lap("clustering")
         if cfg.subclustering:
             ground_xy = pts @ ground_basis(plane[:3]).T
-            people = merge_close_clusters(ground_xy, pieces, cfg.min_head_distance)
+            people = merge_close_clusters(
+                ground_xy, pieces, cfg.min_head_distance, heights, cfg.max_height
+            )
+            people = filter_cluster_sizes(people, cfg.min_points, None)
             people = split_by_heads(
                 ground_xy,
                 heights,
@@ -179,6 +182,7 @@ class Basso2012Detector:
                 cfg.voxel_size,
                 cfg.min_head_distance,
                 cfg.min_head_prominence,
+                (cfg.min_height, cfg.max_height),
             )
             people = filter_cluster_sizes(people, cfg.min_points, cfg.max_points)
         else:
@@ -219,18 +223,22 @@ class Basso2012Detector:
         margin = cfg.cluster_tolerance_voxels * cfg.voxel_size
         footprint = _footprint(frame)
 
-        geometries = [
-            cluster_geometry(
+        # The height filter first (5.4.2), on each cluster's highest full-resolution point.
+        tops = np.full(k, -np.inf)
+        np.maximum.at(tops, point_label[labelled], signed_heights(cloud.points[labelled], plane))
+        in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
+        geometries = {
+            int(c): cluster_geometry(
                 pts[people == c],
                 cloud.points[full_sorted[full_bounds[c] : full_bounds[c + 1]]],
                 plane,
                 cfg.head_centroid,
                 cfg.surface_correction,
             )
-            for c in range(k)
-        ]
+            for c in in_range
+        }
         candidates: list[tuple[float, _Candidate]] = []
-        for c in sorted(range(k), key=lambda i: geometries[i].distance):  # 5.4.2: by distance
+        for c in sorted(geometries, key=lambda i: geometries[i].distance):  # 5.4.2: by distance
             g = geometries[c]
             if not (cfg.min_height <= g.height <= cfg.max_height) or g.distance > cfg.max_distance:
                 continue

@@ -69,6 +69,8 @@ def voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
     cells -= cells.min(axis=0)
     dims = cells.max(axis=0) + 1
     keys = (cells[:, 0] * dims[1] + cells[:, 1]) * dims[2] + cells[:, 2]
+    if int(dims.prod()) < 2**31:  # sorting 32-bit keys is faster
+        keys = keys.astype(np.int32)
     _, point_voxel, counts = np.unique(keys, return_inverse=True, return_counts=True)
     point_voxel = point_voxel.astype(np.int64).reshape(-1)
     m = counts.shape[0]

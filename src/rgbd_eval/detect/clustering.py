@@ -8,11 +8,16 @@ is split between them, every point going to the nearest head on the ground.
 
 Here the heads are found on a true 2D height map over the ground plane (cell =
 one voxel), so that people side by side and one behind the other are both
-separated. A head is a local maximum of the map that is at least
-``min_head_distance`` (on the ground) from every higher head and cannot reach
-any of them without descending by ``min_head_prominence`` (its topographic
-prominence): between two people every path dips to shoulder level, along the
-flat top edge of a cabinet none does.
+separated. A head is a peak of the map within the person height range that is
+at least ``min_head_distance`` (on the ground) from every higher head and cannot
+reach any of them, nor anything taller than a person, without descending by
+``min_head_prominence`` (its topographic prominence): between two people every
+path dips to shoulder level, along the flat top edge of a cabinet none does.
+Parts taller than a person that reach down to the floor (walls) are seeds of
+their own, so a person touching a wall is cut from it; parts above the person
+range that do not reach down (a ceiling seen above people) belong to no one.
+Only person-sized pieces are merged, so a ceiling or a wall whose mean ground
+position happens to fall among people does not swallow them.
 
 Labels are integers per point, ``-1`` for "no cluster".
 """
@@ -29,6 +34,16 @@ from scipy.spatial import cKDTree
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
 
+#: How far (m) from a peak its head region is followed. A head-and-shoulders bump
+#: is far smaller; the limit keeps long structures (wall tops) cheap to examine.
+HEAD_SEARCH_RADIUS = 1.0
+#: Widest ground footprint (m) of a piece merged into a person (bounding-box
+#: diagonal): a walking adult, arms swinging, stays well within it.
+PERSON_MAX_WIDTH = 1.0
+#: Largest vertical gap (m) within one ground cell's column of points that still
+#: counts as one structure reaching down (three 6 cm voxels).
+OVERHANG_GAP = 0.18
+
 
 def euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) -> IntArray:
     """Connected components of the graph linking points closer than ``tolerance``.
@@ -41,7 +56,9 @@ def euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) ->
     n = points.shape[0]
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    pairs = cKDTree(points).query_pairs(tolerance, output_type="ndarray")
+    # Unbalanced, non-compact trees build faster and query as fast here.
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    pairs = tree.query_pairs(tolerance, output_type="ndarray")
     graph = coo_matrix(
         (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)
     )
@@ -81,28 +98,140 @@ def ground_basis(normal: FloatArray) -> FloatArray:
     return np.stack([e1, e2])
 
 
-def merge_close_clusters(ground_xy: FloatArray, labels: IntArray, distance: float) -> IntArray:
-    """Merge clusters whose mean ground positions are closer than ``distance`` (transitively)."""
+def merge_close_clusters(
+    ground_xy: FloatArray,
+    labels: IntArray,
+    distance: float,
+    heights: FloatArray | None = None,
+    max_height: float = np.inf,
+) -> IntArray:
+    """Merge person-sized clusters whose mean ground positions are closer than ``distance``.
+
+    Only pieces that could be part of one person take part: no taller than
+    ``max_height`` (needs ``heights``) and no wider on the ground than
+    :data:`PERSON_MAX_WIDTH`. A ceiling or a wall, whose mean ground position
+    may fall anywhere, would otherwise swallow the people near that point.
+    Merging is transitive.
+    """
     k = int(labels.max()) + 1 if labels.size else 0
     if k < 2:
         return labels
     valid = labels >= 0
-    counts = np.bincount(labels[valid], minlength=k).astype(np.float64)
+    lab = labels[valid]
+    xy = ground_xy[valid]
+    counts = np.bincount(lab, minlength=k).astype(np.float64)
     centres = (
-        np.stack(
-            [np.bincount(labels[valid], weights=ground_xy[valid, j], minlength=k) for j in (0, 1)],
-            axis=1,
-        )
+        np.stack([np.bincount(lab, weights=xy[:, j], minlength=k) for j in (0, 1)], axis=1)
         / np.maximum(counts, 1.0)[:, None]
     )
-    pairs = cKDTree(centres).query_pairs(distance, output_type="ndarray")
+    lo = np.full((k, 2), np.inf)
+    hi = np.full((k, 2), -np.inf)
+    for j in (0, 1):
+        np.minimum.at(lo[:, j], lab, xy[:, j])
+        np.maximum.at(hi[:, j], lab, xy[:, j])
+    mergeable = np.hypot(*(hi - lo).T) <= PERSON_MAX_WIDTH
+    if heights is not None:
+        top = np.full(k, -np.inf)
+        np.maximum.at(top, lab, heights[valid])
+        mergeable &= top <= max_height
+    candidates = np.flatnonzero(mergeable & (counts > 0))
+    if candidates.shape[0] < 2:
+        return labels
+    pairs = candidates[cKDTree(centres[candidates]).query_pairs(distance, output_type="ndarray")]
     if pairs.shape[0] == 0:
         return labels
     graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
     _, merged = connected_components(graph, directed=False)
     out = labels.copy()
-    out[valid] = merged[labels[valid]]
+    out[valid] = merged[lab]
     return _keep_sizes(out, 1, None)
+
+
+def _height_map(
+    ground_xy: FloatArray, heights: FloatArray, cell: float, max_height: float
+) -> tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]]:
+    """Highest point per ground cell, with overhangs taken out.
+
+    Returns the map (one empty cell of border), each point's cell, the origin,
+    and which points are overhangs: above ``max_height`` in a cell whose column
+    does not continue down to the person range (a ceiling or a shelf above
+    people, seen from below). A wall continues down, so it stays in the map,
+    taller than any person.
+    """
+    origin = ground_xy.min(axis=0)
+    ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1
+    shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
+    high = heights > max_height
+    hmap = np.zeros(shape, dtype=np.float64)
+    np.maximum.at(hmap, (ij[~high, 0], ij[~high, 1]), heights[~high])
+    overhang = np.zeros(heights.shape, dtype=bool)
+    if np.any(high):
+        lowest_high = np.full(shape, np.inf)
+        np.minimum.at(lowest_high, (ij[high, 0], ij[high, 1]), heights[high])
+        top_high = np.zeros(shape)
+        np.maximum.at(top_high, (ij[high, 0], ij[high, 1]), heights[high])
+        # A column is continuous when no gap wider than OVERHANG_GAP separates its
+        # points above max_height from those below (or from max_height itself).
+        floor_of_gap = np.maximum(hmap, max_height - OVERHANG_GAP)
+        tall = np.isfinite(lowest_high) & (lowest_high - floor_of_gap <= OVERHANG_GAP)
+        hmap[tall] = top_high[tall]
+        overhang = high & ~tall[ij[:, 0], ij[:, 1]]
+    return hmap, ij, origin, overhang
+
+
+def _head_seeds(
+    hmap: FloatArray,
+    cell: float,
+    min_head_distance: float,
+    min_head_prominence: float,
+    head_heights: tuple[float, float],
+) -> tuple[IntArray, list[FloatArray]]:
+    """Seed regions of the map (0 = none): the heads first (1..H), then tall structures.
+
+    Returns the seed map and the head-region centres (cell coordinates), highest first.
+    """
+    lowest, highest = head_heights
+    seeds = np.zeros(hmap.shape, dtype=np.int64)
+    tall = hmap > highest
+    # A head is the highest point within half the minimum head distance of itself.
+    radius = max(1, int(np.floor(0.5 * min_head_distance / cell)))
+    yy, xx = np.mgrid[-radius : radius + 1, -radius : radius + 1]
+    disk = yy * yy + xx * xx <= radius * radius
+    peaks = (
+        (hmap >= lowest)
+        & ~tall
+        & (hmap >= ndimage.maximum_filter(hmap, footprint=disk, mode="constant"))
+    )
+    pi, pj = np.nonzero(peaks)
+    order = np.lexsort((pj, pi, -hmap[pi, pj]))  # highest first, then raster order
+    # No hole bridging: between two heads 0.4 m apart only two or three cells of
+    # shoulder separate their regions; a hole that splits one head's region leaves
+    # a second peak closer than ``min_head_distance``, which is dropped anyway.
+    half = max(1, int(np.ceil(HEAD_SEARCH_RADIUS / cell)))
+    eight = np.ones((3, 3), dtype=bool)
+    min_cells2 = (min_head_distance / cell) ** 2
+    accepted: list[tuple[int, int]] = []
+    centres: list[FloatArray] = []
+    for i, j in zip(pi[order].tolist(), pj[order].tolist(), strict=True):
+        if any((i - a) ** 2 + (j - b) ** 2 < min_cells2 for a, b in accepted):
+            continue
+        # The head's region: cells reachable from the peak without descending by the
+        # prominence. Another head or a taller structure inside it makes this peak
+        # part of that (followed within HEAD_SEARCH_RADIUS of the peak).
+        i0, j0 = max(0, i - half), max(0, j - half)
+        window = hmap[i0 : i + half + 1, j0 : j + half + 1]
+        regions, _ = ndimage.label(window >= hmap[i, j] - min_head_prominence, structure=eight)
+        mine = regions == regions[i - i0, j - j0]
+        taken = seeds[i0 : i + half + 1, j0 : j + half + 1]
+        if np.any(mine & ((taken > 0) | (window > highest))):
+            continue
+        accepted.append((i, j))
+        taken[mine] = len(accepted)
+        ri, rj = np.nonzero(mine)
+        centres.append(np.array([ri.mean() + i0, rj.mean() + j0]))
+    tall_regions, _ = ndimage.label(tall, structure=eight)
+    seeds[tall] = tall_regions[tall] + len(accepted)
+    return seeds, centres
 
 
 def find_heads(
@@ -111,43 +240,18 @@ def find_heads(
     cell: float,
     min_head_distance: float,
     min_head_prominence: float,
+    head_heights: tuple[float, float] = (0.0, np.inf),
 ) -> FloatArray:
     """Ground positions ``(H, 2)`` of the heads of one cluster, highest first.
 
     ``ground_xy`` are the points' ground-plane coordinates, ``heights`` their
     heights above the floor; the height map keeps the highest point per cell.
+    Only peaks within ``head_heights`` (the person height range) can be heads.
     """
     if ground_xy.shape[0] == 0:
         return np.zeros((0, 2))
-    origin = ground_xy.min(axis=0)
-    ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1  # one empty cell of border
-    shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
-    hmap = np.zeros(shape, dtype=np.float64)
-    np.maximum.at(hmap, (ij[:, 0], ij[:, 1]), heights)
-    occupied = hmap > 0
-    peaks = occupied & (hmap >= ndimage.maximum_filter(hmap, size=3, mode="constant"))
-    pi, pj = np.nonzero(peaks)
-    order = np.lexsort((pj, pi, -hmap[pi, pj]))  # highest first, then raster order
-    pi, pj = pi[order], pj[order]
-    # No hole bridging: between two heads 0.4 m apart only two or three cells of
-    # shoulder separate their regions; a hole that splits one head's region leaves
-    # a second peak closer than ``min_head_distance``, which is dropped anyway.
-    eight = np.ones((3, 3), dtype=bool)
-    accepted: list[tuple[int, int]] = []
-    centres: list[FloatArray] = []
-    for i, j in zip(pi.tolist(), pj.tolist(), strict=True):
-        if any(np.hypot(i - a, j - b) * cell < min_head_distance for a, b in accepted):
-            continue
-        # The head's region: cells reachable from the peak without descending by the
-        # prominence. A higher head inside it makes this peak part of that head.
-        regions, _ = ndimage.label(hmap >= hmap[i, j] - min_head_prominence, structure=eight)
-        own = regions[i, j]
-        if any(regions[a, b] == own for a, b in accepted):
-            continue
-        accepted.append((i, j))
-        ri, rj = np.nonzero((regions == own) & occupied)
-        centre = np.array([ri.mean(), rj.mean()]) if ri.size else np.array([i, j], float)
-        centres.append(centre)
+    hmap, _, origin, _ = _height_map(ground_xy, heights, cell, head_heights[1])
+    _, centres = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
     cells = np.asarray(centres, dtype=np.float64).reshape(-1, 2)
     heads: FloatArray = origin + (cells - 1 + 0.5) * cell
     return heads
@@ -160,8 +264,13 @@ def split_by_heads(
     cell: float,
     min_head_distance: float,
     min_head_prominence: float,
+    head_heights: tuple[float, float] = (0.0, np.inf),
 ) -> IntArray:
-    """Split every cluster between its heads: each point goes to the nearest head on the ground."""
+    """Split every cluster between its heads and taller structures.
+
+    Each point goes to the seed region (a head's region, or a connected part of
+    the cluster taller than any person) nearest to its cell on the ground.
+    """
     out = np.full(labels.shape, -1, dtype=np.int64)
     next_label = 0
     k = int(labels.max()) + 1 if labels.size else 0
@@ -169,14 +278,22 @@ def split_by_heads(
     bounds = np.searchsorted(labels[members_sorted], np.arange(k + 1))
     for c in range(k):
         members = members_sorted[bounds[c] : bounds[c + 1]]
-        heads = find_heads(
-            ground_xy[members], heights[members], cell, min_head_distance, min_head_prominence
+        hmap, ij, _, overhang = _height_map(
+            ground_xy[members], heights[members], cell, head_heights[1]
         )
-        if heads.shape[0] <= 1:
+        seeds, heads = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
+        n_seeds = int(seeds.max())
+        if not heads:  # no person in it: left whole (the height filter judges it)
             out[members] = next_label
             next_label += 1
             continue
-        d2 = ((ground_xy[members, None, :] - heads[None, :, :]) ** 2).sum(axis=2)
-        out[members] = next_label + np.argmin(d2, axis=1)
-        next_label += heads.shape[0]
-    return out
+        if n_seeds == 1:
+            sub = np.zeros(members.shape[0], dtype=np.int64)
+        else:
+            # Nearest seed cell of every cell (Euclidean distance transform).
+            _, (ni, nj) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
+            sub = seeds[ni, nj][ij[:, 0], ij[:, 1]] - 1
+        # Overhangs (a ceiling above the people) belong to no person.
+        out[members] = np.where(overhang, -1, next_label + sub)
+        next_label += n_seeds
+    return _keep_sizes(out, 1, None)
