@@ -20,9 +20,22 @@ def test_defaults_are_the_thesis_tables() -> None:
     # Table 6.1
     t = c.tracker
     assert (t.gate_distance_probability, t.acceleration_variance) == (0.999, 4.0)
-    assert (t.weak_classifiers, t.selectors, t.min_prediction, t.min_confidence) == (250, 50, 9.0, -0.5)
-    assert (t.frames_before_old, t.frames_before_fake, t.frames_remain_new, t.detections_to_validate) == (
-        90, 60, 30, 3,
+    assert (t.weak_classifiers, t.selectors, t.min_prediction, t.min_confidence) == (
+        250,
+        50,
+        9.0,
+        -0.5,
+    )
+    assert (
+        t.frames_before_old,
+        t.frames_before_fake,
+        t.frames_remain_new,
+        t.detections_to_validate,
+    ) == (
+        90,
+        60,
+        30,
+        3,
     )
     assert t.seconds(t.frames_before_old) == 3.0  # 90 frames at the Kinect's 30 Hz
     assert c.evaluation.gating is Gating.IOU and c.evaluation.effective_threshold() == 0.5
@@ -36,7 +49,9 @@ def test_overrides_are_typed() -> None:
     assert c.evaluation.effective_threshold() == 1.0
     with pytest.raises(ConfigError, match=r"tracker.min_confidence: .*\(got 'abc'\)"):
         build_config({}, parse_overrides(["tracker.min_confidence=abc"]))
-    with pytest.raises(ConfigError, match=r"unknown key 'min_conf' in tracker \(known: .*min_confidence"):
+    with pytest.raises(
+        ConfigError, match=r"unknown key 'min_conf' in tracker \(known: .*min_confidence"
+    ):
         build_config({}, parse_overrides(["tracker.min_conf=1"]))
     with pytest.raises(ConfigError, match="expected KEY=VALUE"):
         parse_overrides(["tracker.min_confidence"])
@@ -52,7 +67,10 @@ def test_overrides_are_typed() -> None:
         ({"detector": {"voxel_size": 0}}, r"detector.voxel_size: Input should be greater than 0"),
         ({"tracker": {"gate_distance_probability": 1.0}}, "gate_distance_probability"),
         ({"tracker": {"selectors": 300}}, "selectors=300 must not exceed weak_classifiers=250"),
-        ({"evaluation": {"gating": "iou", "threshold": 1.5}}, r"IoU threshold=1.5 must be in \(0, 1\]"),
+        (
+            {"evaluation": {"gating": "iou", "threshold": 1.5}},
+            r"IoU threshold=1.5 must be in \(0, 1\]",
+        ),
         ({"detector": {"ground_mode": "points"}}, "ground_mode 'points' needs"),
     ],
 )

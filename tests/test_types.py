@@ -22,7 +22,9 @@ def axis_angle(ax: float, ay: float, az: float) -> tuple[float, float, float, fl
 
 
 @given(angles, angles, angles, coords, coords, coords)
-def test_pose_inverse_and_matrix_round_trip(a: float, b: float, c: float, x: float, y: float, z: float) -> None:
+def test_pose_inverse_and_matrix_round_trip(
+    a: float, b: float, c: float, x: float, y: float, z: float
+) -> None:
     p = Pose((x, y, z), axis_angle(a, b, c))
     np.testing.assert_allclose(p.compose(p.inverse()).matrix(), np.eye(4), atol=1e-9)
     np.testing.assert_allclose(Pose.from_matrix(p.matrix()).matrix(), p.matrix(), atol=1e-9)
@@ -40,7 +42,9 @@ def test_camera_project_backproject() -> None:
     np.testing.assert_allclose(cam.project(np.array([[0.5, 0.25, 2.0]])), [[450.75, 305.125]])
     depth = np.full((480, 640), 2.0, np.float32)
     pts = cam.backproject(depth)
-    np.testing.assert_allclose(pts[305, 450], [(450 - 319.5) * 2 / 525, (305 - 239.5) * 2 / 525, 2.0])
+    np.testing.assert_allclose(
+        pts[305, 450], [(450 - 319.5) * 2 / 525, (305 - 239.5) * 2 / 525, 2.0]
+    )
     # Decimation by 4 keeps the same field of view: pixel centres map consistently.
     small = cam.scaled(160, 120)
     assert (small.fx, small.cx) == (131.25, (319.5 + 0.5) / 4 - 0.5)

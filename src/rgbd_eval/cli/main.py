@@ -9,6 +9,7 @@ from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.run import run
 from rgbd_eval.cli.sweep_cmd import sweep
+from rgbd_eval.cli.synth_cmd import synth
 
 app = typer.Typer(
     name="rgbd-eval",
@@ -21,6 +22,7 @@ app.command("run")(run)
 app.command("sweep")(sweep)
 app.command("inspect")(inspect)
 app.command("compare")(compare)
+app.command("synth")(synth)
 
 
 def _version(value: bool) -> None:

@@ -59,10 +59,14 @@ def expand_inputs(paths: list[Path]) -> list[Path]:
     return out
 
 
-def ensure_demo(path: Path) -> None:
-    """The demo recording must exist (``make run`` generates it)."""
+def ensure_demo() -> Path:
+    """The demo recording, generated on first use (deterministic, a few seconds)."""
+    from rgbd_eval.sim import demo_recording  # imported lazily: open3d is slow to import
+
+    path = default_demo()
     if not path.exists():
-        raise InputError(path, "demo recording not found; generate it with `make run`")
+        err_console.print(f"generating the demo recording {path} (first use) ...")
+    return demo_recording()
 
 
 def print_table(results: list[SequenceResult], config: RunConfig) -> None:
@@ -131,9 +135,7 @@ def run(
     config = load_config(config_file, sets, method=method or (None if config_file else "basso2012"))
     inputs = list(paths or [])
     if not inputs:
-        demo = default_demo()
-        ensure_demo(demo)
-        inputs = [demo]
+        inputs = [ensure_demo()]
     recordings = expand_inputs(inputs)
     if gt is not None and len(recordings) > 1:
         raise InputError(

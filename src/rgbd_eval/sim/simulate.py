@@ -1,0 +1,269 @@
+"""The frame loop: scenario + seed -> rendered, noisy frames with exact ground truth.
+
+:class:`Simulator` holds what is built once (static mesh, camera models, the
+timelines, the odometry track) and renders frame ``i`` on demand. Random
+streams are derived from ``(seed, stream)`` so that each frame's noise depends
+only on the seed and the frame index: same scenario and seed, same bytes.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+import open3d as o3d
+from numpy.typing import NDArray
+
+from rgbd_eval.sim import rig
+from rgbd_eval.sim.annotate import NEAR_M, person_ground_truth, projected_extent
+from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
+from rgbd_eval.sim.meshes import MAT_SHINY, MAT_SKIN, Mesh, concatenate
+from rgbd_eval.sim.motion import (
+    STRIDE_PER_HEIGHT,
+    clothes_at,
+    follower_state,
+    gait_amplitude,
+    person_state,
+    person_timeline,
+    robot_pose,
+    robot_timeline,
+)
+from rgbd_eval.sim.odometry import integrate_odometry
+from rgbd_eval.sim.render import (
+    Hits,
+    light_direction,
+    make_scene,
+    object_ids,
+    occluded_towards,
+    overlay_hits,
+    render_hits,
+    shade,
+)
+from rgbd_eval.sim.scenario import Scenario
+from rgbd_eval.sim.sensor import (
+    depth_edges,
+    dropout_probability,
+    exposure_gain,
+    frame_noise,
+    noise_bank,
+    noisy_depth,
+    noisy_rgb,
+)
+from rgbd_eval.sim.world import static_mesh
+from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
+
+# Random stream numbers (never reorder: they fix the bytes of every recording).
+_STREAM_ODOMETRY = 1
+_STREAM_DEPTH = 2
+_STREAM_RGB = 3
+_STREAM_RGB_BANK = 4
+#: Noise images drawn once per recording; each frame shifts one of them at random.
+_NOISE_BANK = 4
+
+
+def _rng(seed: int, stream: int, index: int = 0) -> np.random.Generator:
+    return np.random.default_rng([seed, stream, index])
+
+
+def people_window(people: Mesh, camera: CameraModel, pose: Pose) -> tuple[int, int, int, int]:
+    """Image window (u0, v0, u1, v1) that holds every pixel the people can cover.
+
+    The projected vertices bound the people's pixels unless a triangle crosses the
+    plane near the camera; then the whole image is used.
+    """
+    if people.n_triangles == 0:
+        return (0, 0, 0, 0)
+    z = pose.inverse().transform_points(people.vertices)[:, 2]
+    if np.all(z <= NEAR_M):
+        return (0, 0, 0, 0)
+    if np.any(z <= NEAR_M):
+        return (0, 0, camera.width, camera.height)
+    extent = projected_extent(people.vertices, camera, pose)
+    if extent is None:  # pragma: no cover - all vertices are in front here
+        return (0, 0, 0, 0)
+    u0, v0, u1, v1 = extent
+    # pixel centres (edge coordinate - 0.5) inside the extent, one pixel of margin
+    return (
+        min(max(math.floor(u0 - 0.5) - 1, 0), camera.width),
+        min(max(math.floor(v0 - 0.5) - 1, 0), camera.height),
+        min(max(math.ceil(u1 - 0.5) + 2, 0), camera.width),
+        min(max(math.ceil(v1 - 0.5) + 2, 0), camera.height),
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class SimFrame:
+    """One synthetic instant: sensor images, poses and ground truth."""
+
+    index: int
+    stamp_ns: int
+    t: float
+    rgb: NDArray[np.uint8]
+    depth: NDArray[np.float32]  # decimated, metres, NaN invalid
+    ids: NDArray[np.int32]  # RGB-camera id buffer (full resolution)
+    base_true: Pose  # world_T_base_link
+    base_odom: Pose  # odom_T_base_link (drifting)
+    rgb_pose: Pose  # true world_T_rgb_optical
+    ground_truth: list[GroundTruthObject]
+
+
+class Simulator:
+    """Renders the frames of one scenario for one seed."""
+
+    def __init__(self, scenario: Scenario, seed: int | None = None) -> None:
+        self.scenario = scenario
+        self.seed = scenario.seed if seed is None else int(seed)
+        if self.seed < 0:
+            raise ValueError(f"seed={self.seed} must be non-negative")
+        s = scenario.sensor
+        self.rgb_camera: CameraModel = rig.rgb_camera(s)
+        self.depth_camera_full: CameraModel = rig.depth_camera_full(s)
+        self.depth_camera: CameraModel = rig.depth_camera(s)
+        self.base_to_link = rig.base_to_camera_link(scenario.robot)
+        self.link_to_rgb = rig.camera_link_to_rgb()
+        self.link_to_depth = rig.camera_link_to_depth(s)
+        self.static = static_mesh(scenario.room, scenario.obstacles)
+        self._static_scene = make_scene(self.static)
+        self._static_hits: dict[str, tuple[tuple[object, ...], Hits]] = {}
+        self.light = light_direction(s.light_azimuth_deg, s.light_elevation_deg)
+        leaders = {p.id: p for p in scenario.people if p.follow is None}
+        timelines = {pid: person_timeline(p) for pid, p in leaders.items()}
+        #: per person: whose path drives it, and that path's timeline
+        self._drivers = [
+            (leaders[p.follow.id] if p.follow else p, timelines[p.follow.id if p.follow else p.id])
+            for p in scenario.people
+        ]
+        self._robot_segments = robot_timeline(scenario.robot)
+        times = [self.time(i) for i in range(scenario.n_frames)]
+        true = np.array([robot_pose(scenario.robot, self._robot_segments, t) for t in times])
+        self.true_poses = true
+        shape = (s.height, s.width, 3)
+        self._noise = noise_bank(shape, _NOISE_BANK, _rng(self.seed, _STREAM_RGB_BANK))
+        self.odom_poses = integrate_odometry(
+            true, scenario.odometry, _rng(self.seed, _STREAM_ODOMETRY)
+        )
+
+    @property
+    def n_frames(self) -> int:
+        return self.scenario.n_frames
+
+    def time(self, index: int) -> float:
+        """Seconds since the start of frame ``index``."""
+        return index / self.scenario.sensor.rate_hz
+
+    def people_meshes(self, t: float) -> list[tuple[int, Mesh, float, tuple[float, float]]]:
+        """(id, mesh, top height, ground xy) of every person present at time t."""
+        out = []
+        for person, (driver, segs) in zip(self.scenario.people, self._drivers, strict=True):
+            st = person_state(driver, segs, t)
+            if person.follow is not None:
+                st = follower_state(st, person.follow)
+            if not st.present:
+                continue
+            shirt, trousers = clothes_at(person, t)
+            outfit = Outfit(
+                shirt,
+                trousers,
+                person.skin,
+                person.hair,
+                person.shoes,
+                person.bag_colour if person.bag else None,
+            )
+            stride = STRIDE_PER_HEIGHT * person.height
+            posture = Posture(
+                phase=2.0 * math.pi * st.distance / stride,
+                amplitude=gait_amplitude(driver, segs, t),
+                sit=st.sit,
+            )
+            mesh, top = figure_mesh(
+                person.height, st.x, st.y, st.heading, posture, outfit, person.id
+            )
+            out.append((person.id, mesh, top, (st.x, st.y)))
+        return out
+
+    def frame(self, index: int) -> SimFrame:
+        """Render frame ``index`` (any order; the result depends only on seed and index)."""
+        if not 0 <= index < self.n_frames:
+            raise ValueError(f"index={index} must be in [0, {self.n_frames})")
+        sc = self.scenario
+        s = sc.sensor
+        t = self.time(index)
+        x, y, yaw = self.true_poses[index]
+        base_true = rig.base_pose(float(x), float(y), float(yaw))
+        ox, oy, oyaw = self.odom_poses[index]
+        base_odom = rig.base_pose(float(ox), float(oy), float(oyaw))
+        link = base_true.compose(self.base_to_link)
+        rgb_pose = link.compose(self.link_to_rgb)
+        depth_pose = link.compose(self.link_to_depth)
+
+        people = self.people_meshes(t)
+        people_mesh = concatenate([m for _, m, _, _ in people])
+        mesh = concatenate([self.static, people_mesh])
+        people_scene = make_scene(people_mesh)
+
+        # RGB: shaded colour and the id buffer used for visibility
+        hits = self._render(people_mesh, people_scene, self.rgb_camera, rgb_pose)
+        clean = shade(mesh, hits, self.light, sc.room.floor_tile)
+        ids = object_ids(mesh, hits)
+        gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s)
+        noise = frame_noise(self._noise, _rng(self.seed, _STREAM_RGB, index))
+        rgb = noisy_rgb(clean, gain, s.rgb_noise_std, noise)
+
+        # depth: ideal z from the depth camera, then the sensor model
+        # Rays go through the published (decimated) camera's pixel centres, so the
+        # image agrees with its CameraInfo; edges are found on the published grid.
+        dh = self._render(people_mesh, people_scene, self.depth_camera, depth_pose)
+        edges = depth_edges(dh.depth, s.edge_jump)
+        tri = dh.triangle
+        hit = tri >= 0
+        safe = np.where(hit, tri, 0)
+        albedo = mesh.colours[safe]
+        luminance = albedo @ np.array([0.299, 0.587, 0.114])
+        material = mesh.materials[safe]
+        dark = hit & (luminance < s.dark_level) & (material != MAT_SKIN)
+        shiny = hit & (material == MAT_SHINY)
+        dropout = dropout_probability(edges, dark, shiny, s)
+        if s.projector_shadows:
+            # structured light: what the projector cannot see returns no depth
+            projector = depth_pose.transform_points(np.array([[s.baseline_m, 0.0, 0.0]]))[0]
+            seen = np.flatnonzero(hit)
+            points = dh.points().reshape(-1, 3)[seen]
+            shadow = occluded_towards([self._static_scene, people_scene], points, projector)
+            dropout.flat[seen[shadow]] = 1.0
+        depth = noisy_depth(
+            dh.depth,
+            dropout,
+            s,
+            self.depth_camera_full.fx,
+            _rng(self.seed, _STREAM_DEPTH, index),
+        )
+
+        stamp = sc.stamp_ns(index)
+        gt = [
+            person_ground_truth(index, stamp, pid, m, top, xy, ids, self.rgb_camera, rgb_pose)
+            for pid, m, top, xy in people
+        ]
+        return SimFrame(index, stamp, t, rgb, depth, ids, base_true, base_odom, rgb_pose, gt)
+
+    def _render(
+        self,
+        people: Mesh,
+        people_scene: o3d.t.geometry.RaycastingScene,
+        camera: CameraModel,
+        pose: Pose,
+    ) -> Hits:
+        """Hits of static scene + people: the static part is cached while the camera stands."""
+        key = (camera.frame_id, pose.translation, pose.rotation)
+        base = self._static_hits.get(camera.frame_id)
+        if base is None or base[0] != key:
+            base = (key, render_hits(self._static_scene, camera, pose))
+            self._static_hits[camera.frame_id] = base
+        window = people_window(people, camera, pose)
+        return overlay_hits(base[1], people_scene, window, self.static.n_triangles)
+
+    def frames(self, indices: list[int] | None = None) -> Iterator[SimFrame]:
+        """Frames in order (all, or the given indices)."""
+        for i in range(self.n_frames) if indices is None else indices:
+            yield self.frame(i)

@@ -1,0 +1,174 @@
+"""Write a scenario as a recording (ROS1 .bag or ROS2 .mcap) plus its ground-truth CSV.
+
+Topics and tf tree (see :mod:`rgbd_eval.sim.rig`): RGB and depth images with
+their CameraInfos, ``/odom`` and ``/tf`` (odom -> base_link, drifting
+odometry), ``/tf_static`` (base_link -> camera_link -> optical frames) and
+``/ground_truth`` (true world frame). The sidecar ``<stem>.gt.csv`` holds the
+same ground truth.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Literal
+
+from rgbd_eval.config import repo_root
+from rgbd_eval.io.groundtruth import write_csv
+from rgbd_eval.io.writer import RecordingWriter, StreamOptions
+from rgbd_eval.sim import rig
+from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
+from rgbd_eval.sim.simulate import SimFrame, Simulator
+from rgbd_eval.types import GroundTruthObject
+
+ProgressCallback = Callable[[int, int], None]
+SynthContainer = Literal["ros1", "mcap"]
+
+
+@dataclass(frozen=True)
+class SynthResult:
+    """What :func:`synthesize` wrote and how fast."""
+
+    recording: Path
+    ground_truth_csv: Path
+    frames: int
+    people_instances: int
+    seconds: float
+    recording_bytes: int
+
+    @property
+    def frames_per_second(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else float("inf")
+
+
+def ground_truth_path(out_path: Path | str) -> Path:
+    """The sidecar CSV next to a recording: ``<dir>/<stem>.gt.csv``."""
+    p = Path(out_path)
+    return p.with_name(p.stem + ".gt.csv")
+
+
+def stream_options(scenario: Scenario) -> StreamOptions:
+    """The writer options a scenario asks for."""
+    r = scenario.recording
+    return StreamOptions(
+        rgb_format=r.rgb_format,
+        depth_encoding=r.depth_encoding,
+        depth_compressed=r.depth_compressed,
+        jpeg_quality=r.jpeg_quality,
+    )
+
+
+def container_for(out_path: Path | str) -> SynthContainer:
+    """``ros1`` for ``.bag``, ``mcap`` for ``.mcap``; anything else is a ValueError."""
+    suffix = Path(out_path).suffix
+    if suffix == ".bag":
+        return "ros1"
+    if suffix == ".mcap":
+        return "mcap"
+    raise ValueError(f"out_path={str(out_path)!r} must end in .bag or .mcap")
+
+
+def _write_frame(w: RecordingWriter, sim: Simulator, f: SimFrame) -> None:
+    stamp = f.stamp_ns
+    w.write_odometry(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
+    w.write_transform(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
+    w.write_rgb(stamp, f.rgb, sim.rgb_camera)
+    w.write_depth(stamp, f.depth, sim.depth_camera)
+    w.write_ground_truth(stamp, rig.WORLD_FRAME, f.ground_truth)
+
+
+def synthesize(
+    scenario: Scenario,
+    out_path: Path | str,
+    container: SynthContainer | None = None,
+    seed: int | None = None,
+    progress: ProgressCallback | None = None,
+    overwrite: bool = True,
+    max_frames: int | None = None,
+) -> SynthResult:
+    """Render ``scenario`` and write it to ``out_path`` plus ``<stem>.gt.csv``.
+
+    ``container`` defaults from the suffix (``.bag`` -> ros1, ``.mcap`` -> mcap);
+    ``seed`` defaults to the scenario's; ``progress(done, total)`` is called after
+    every frame; ``max_frames`` truncates the sequence (tests, previews).
+    Both files appear atomically. Same scenario and seed give the same bytes.
+    """
+    out = Path(out_path)
+    kind: SynthContainer = container if container is not None else container_for(out)
+    if kind not in ("ros1", "mcap"):
+        raise ValueError(f"container={kind!r} must be 'ros1' or 'mcap'")
+    sim = Simulator(scenario, seed)
+    total = sim.n_frames if max_frames is None else min(sim.n_frames, max_frames)
+    if total < 1:
+        raise ValueError(f"max_frames={max_frames} must be at least 1")
+    start = time.perf_counter()
+    truth: list[GroundTruthObject] = []
+    first = scenario.stamp_ns(0)
+    with RecordingWriter(
+        out, container=kind, options=stream_options(scenario), overwrite=overwrite
+    ) as w:
+        w.write_static_transform(first, rig.BASE_FRAME, rig.CAMERA_LINK, sim.base_to_link)
+        w.write_static_transform(first, rig.CAMERA_LINK, rig.RGB_FRAME, sim.link_to_rgb)
+        w.write_static_transform(first, rig.CAMERA_LINK, rig.DEPTH_FRAME, sim.link_to_depth)
+        for f in sim.frames(list(range(total))):
+            _write_frame(w, sim, f)
+            truth.extend(f.ground_truth)
+            if progress is not None:
+                progress(f.index + 1, total)
+    csv_path = ground_truth_path(out)
+    write_csv(csv_path, truth)
+    elapsed = time.perf_counter() - start
+    return SynthResult(out, csv_path, total, len(truth), elapsed, out.stat().st_size)
+
+
+# ----------------------------------------------------------------------------- datasets/
+
+#: The scenario of the embedded demo sequence.
+DEMO = "demo"
+
+
+def dataset_path(name: str, container: SynthContainer = "mcap") -> Path:
+    """Where ``synth --all`` puts a scenario's recording.
+
+    The small demo lives in ``datasets/`` (committed or generated on first use);
+    the thesis sequences go to the git-ignored ``datasets/generated/``.
+    """
+    if container not in ("ros1", "mcap"):
+        raise ValueError(f"container={container!r} must be 'ros1' or 'mcap'")
+    suffix = ".bag" if container == "ros1" else ".mcap"
+    folder = repo_root() / "datasets"
+    if name != DEMO:
+        folder = folder / "generated"
+    return folder / f"{name}{suffix}"
+
+
+def demo_recording(progress: ProgressCallback | None = None) -> Path:
+    """The demo recording ``datasets/demo.mcap``, generated (scenario seed) if missing."""
+    path = dataset_path(DEMO)
+    if not path.exists() or not ground_truth_path(path).exists():
+        synthesize(load_scenario(scenarios_dir() / f"{DEMO}.yaml"), path, "mcap", None, progress)
+    return path
+
+
+def synthesize_all(
+    container: SynthContainer = "mcap",
+    seed: int | None = None,
+    progress: Callable[[str, int, int], None] | None = None,
+) -> list[SynthResult]:
+    """``synth --all``: every scenario of ``configs/scenarios`` to its :func:`dataset_path`.
+
+    ``progress(name, done, total)`` is called after every frame.
+    """
+    results = []
+    for path in scenario_paths():
+        scenario = load_scenario(path)
+        name = path.stem
+
+        def report(done: int, total: int, name: str = name) -> None:
+            if progress is not None:
+                progress(name, done, total)
+
+        results.append(synthesize(scenario, dataset_path(name, container), container, seed, report))
+    return results
