@@ -128,6 +128,19 @@ def markdown_table(results: Sequence[SequenceResult], gating: Gating) -> str:
     return "\n".join(lines) + "\n"
 
 
+def run_notes(results: Sequence[SequenceResult]) -> list[str]:
+    """What a reader must know besides the table: unscored sequences and reader warnings."""
+    notes = []
+    for r in results:
+        if r.scores is None:
+            notes.append(
+                f"{r.name}: no ground truth found, nothing scored "
+                f"({sum(len(d) for d in r.detections.detections)} detections and the tracks written)"
+            )
+        notes += [f"{r.name}: warning: {w}" for w in r.info.warnings]
+    return notes
+
+
 def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
     info = r.info
     gt = r.ground_truth
@@ -351,14 +364,7 @@ def write_run(
         ]
         if any(r.scores is not None for r in results):
             md.append(markdown_table(results, config.evaluation.gating))
-        for r in results:
-            if r.scores is None:
-                md.append(
-                    f"- {r.name}: no ground truth, nothing scored "
-                    f"({sum(len(d) for d in r.detections.detections)} detections written)."
-                )
-            for w in r.info.warnings:
-                md.append(f"- {r.name}: {w}")
+        md += [f"- {note}" for note in run_notes(results)]
         (tmp / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
         (tmp / "report.json").write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"

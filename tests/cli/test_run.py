@@ -20,7 +20,7 @@ def test_unscored_run_writes_outputs(tmp_path: Path) -> None:
     out = tmp_path / "out"
     result = runner.invoke(app, ["run", str(rec), "--out", str(out)])
     assert result.exit_code == 0, result.output
-    assert "no ground truth found; nothing scored" in result.output
+    assert "no ground truth found, nothing scored" in result.output
     report = json.loads((out / "report.json").read_text())
     assert report["schema_version"] == 1 and report["overall"] is None
     seq = report["sequences"][0]

@@ -18,7 +18,13 @@ import numpy as np
 
 from rgbd_eval.detect.hog import hog_confidence
 from rgbd_eval.sim.annotate import clip_box, projected_extent
-from rgbd_eval.sim.scenario import ObstacleKind, Scenario, load_scenario, scenario_paths
+from rgbd_eval.sim.scenario import (
+    ObstacleKind,
+    Scenario,
+    load_scenario,
+    parse_scenario,
+    scenario_paths,
+)
 from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.sim.world import OBSTACLE_ID_BASE
 
@@ -27,6 +33,34 @@ PERSON_SIZED = (ObstacleKind.COAT_STAND, ObstacleKind.PLANT, ObstacleKind.CABINE
 FULLY_VISIBLE = 0.98
 MIN_DIST, MAX_DIST = 1.5, 6.0
 
+
+#: A small scene with every person-sized object kind (cabinet included) and three people.
+GALLERY: dict[str, object] = {
+    "name": "gallery",
+    "duration_s": 2.0,
+    "obstacles": [
+        {"kind": "coat_stand", "x": 4.0, "y": 1.3},
+        {"kind": "plant", "x": 4.5, "y": -1.4},
+        {"kind": "cabinet", "x": 5.0, "y": 0.2, "yaw_deg": 180},
+    ],
+    "people": [
+        {"id": 1, "height": 1.75, "path": [{"x": 3.4, "y": 1.8}, {"x": 3.4, "y": -1.8}]},
+        {
+            "id": 2,
+            "height": 1.6,
+            "shirt": [170, 40, 40],
+            "bag": True,
+            "path": [{"x": 5.8, "y": -2.5}, {"x": 5.8, "y": 2.5}],
+        },
+        {
+            "id": 3,
+            "height": 1.9,
+            "shirt": [220, 220, 210],
+            "trousers": [30, 40, 90],
+            "path": [{"x": 4.6, "y": 2.6}, {"x": 4.6, "y": -2.6, "speed": 1.4}],
+        },
+    ],
+}
 
 #: An object's box with more person pixels than this share is not scored (a person in front).
 MAX_PERSON_SHARE = 0.02
@@ -115,3 +149,8 @@ if __name__ == "__main__":
         print(f"{kind:18s} objects {summary(values)}")
     below = np.mean(np.asarray(total.objects) < -1.5) if total.objects else float("nan")
     print(f"objects below -1.5: {below:.1%}")
+    gallery = Scores()
+    measure(parse_scenario(GALLERY), 1, gallery)
+    print(f"{'gallery':18s} people  {summary(gallery.people)}")
+    for kind, values in sorted(gallery.by_kind.items()):
+        print(f"{'gallery ' + kind:18s} objects {summary(values)}")

@@ -8,17 +8,15 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.progress import (
-    BarColumn,
-    MofNCompleteColumn,
-    Progress,
-    TaskID,
-    TextColumn,
-    TimeRemainingColumn,
-)
 from rich.table import Table
 
-from rgbd_eval.cli.common import console, err_console, handle_errors
+from rgbd_eval.cli.common import (
+    advance_callback,
+    console,
+    err_console,
+    handle_errors,
+    progress_bar,
+)
 from rgbd_eval.config import RunConfig, load_config, repo_root
 from rgbd_eval.errors import InputError
 
@@ -70,7 +68,7 @@ def ensure_demo() -> Path:
 
 
 def print_table(results: list[SequenceResult], config: RunConfig) -> None:
-    from rgbd_eval.report import table_header, table_rows
+    from rgbd_eval.report import run_notes, table_header, table_rows
 
     scored = [r for r in results if r.scores is not None]
     if scored:
@@ -84,14 +82,8 @@ def print_table(results: list[SequenceResult], config: RunConfig) -> None:
         for row in table_rows(results, config.evaluation.gating):
             table.add_row(*row, style="bold" if row[0] == "overall" else None)
         console.print(table)
-    for r in results:
-        if r.scores is None:
-            console.print(
-                f"{r.name}: no ground truth found; nothing scored "
-                f"({sum(len(d) for d in r.detections.detections)} detections, tracks written)"
-            )
-        for w in r.info.warnings:
-            console.print(f"[yellow]warning:[/] {r.name}: {w}")
+    for note in run_notes(results):
+        console.print(note)
 
 
 @handle_errors
@@ -143,23 +135,11 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=err_console,
-        transient=True,
-        disable=not err_console.is_terminal,
-    ) as progress:
+    with progress_bar() as bar:
         for path in recordings:
-            task = progress.add_task(path.name, total=None)
-
-            def advance(done: int, total: int, task: TaskID = task) -> None:
-                progress.update(task, completed=done, total=total)
-
-            results.append(run_sequence(path, config, gt, advance))
-            progress.remove_task(task)
+            task = bar.add_task(path.name, total=None)
+            results.append(run_sequence(path, config, gt, advance_callback(bar, task)))
+            bar.remove_task(task)
     report = write_run(out_dir, results, config)
     if json_out:
         typer.echo(json.dumps(report, indent=2))

@@ -6,9 +6,8 @@ from pathlib import Path
 from typing import Annotated, Literal
 
 import typer
-from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
 
-from rgbd_eval.cli.common import console, err_console, handle_errors
+from rgbd_eval.cli.common import advance_callback, console, handle_errors, progress_bar
 from rgbd_eval.errors import ConfigError
 
 
@@ -65,22 +64,11 @@ def synth(
         if preview is not None:
             written = write_preview(load_scenario(path), preview, seed)
             console.print(f"preview: {written}")
-    with Progress(
-        TextColumn("{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TimeRemainingColumn(),
-        console=err_console,
-        transient=True,
-        disable=not err_console.is_terminal,
-    ) as bar:
+    with progress_bar() as bar:
         for scenario_path, target in jobs:
             sc = load_scenario(scenario_path)
             task = bar.add_task(scenario_path.stem, total=None)
-
-            def advance(done: int, total: int, task: object = task) -> None:
-                bar.update(task, completed=done, total=total)  # type: ignore[arg-type]
-
+            advance = advance_callback(bar, task)
             try:
                 result = synthesize(sc, target, container, seed, advance, max_frames=frames)
             except ValueError as err:
