@@ -7,6 +7,7 @@ import typer
 from rgbd_eval import __version__
 from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
+from rgbd_eval.cli.reproduce_cmd import reproduce
 from rgbd_eval.cli.run import run
 from rgbd_eval.cli.sweep_cmd import sweep
 from rgbd_eval.cli.synth_cmd import synth
@@ -23,6 +24,7 @@ app.command("sweep")(sweep)
 app.command("inspect")(inspect)
 app.command("compare")(compare)
 app.command("synth")(synth)
+app.command("reproduce")(reproduce)
 
 
 def _version(value: bool) -> None:
