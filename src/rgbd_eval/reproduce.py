@@ -21,7 +21,7 @@ from rgbd_eval.config import RunConfig, build_config, load_config, repo_root
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.metrics import Counts, summarize, total
-from rgbd_eval.pipeline import sequence_name, track_sequence
+from rgbd_eval.pipeline import detect_sequence, sequence_name, track_sequence
 from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import TrackStatus, Visibility
@@ -100,10 +100,12 @@ def _sweep(
 
 def track_lengths(config: RunConfig, recording: Path, cache: Path | None) -> list[int]:
     """Frames each distinct validated track is visible (Figure 7.7), from cached detections."""
+    store = DetectionCache(cache)
     key = detection_key(file_digest(recording), config)
-    detections = DetectionCache(cache).load(key)
-    if detections is None:
-        raise ValueError(f"{recording}: detections not cached for this config")
+    detections = store.load(key)
+    if detections is None:  # not cached (or the file changed since): detect now
+        detections = detect_sequence(open_recording(recording, config.io), config)
+        store.store(key, detections)
     frames: dict[int, int] = {}
     for tracks in track_sequence(detections, config):
         for t in tracks:
