@@ -35,6 +35,14 @@ datasets: $(STAMP)
 run: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval run $(DEMO)
 
+# One-core figures: the demo and one thesis scenario, JSON under runs/bench/.
+bench: $(STAMP) $(DEMO)
+	@mkdir -p runs/bench
+	OPENBLAS_NUM_THREADS=1 $(BIN)/rgbd-eval bench $(DEMO) --repeat 3 --json > runs/bench/demo.json
+	@test -f datasets/generated/moving_complex.mcap || $(BIN)/rgbd-eval synth moving_complex
+	OPENBLAS_NUM_THREADS=1 $(BIN)/rgbd-eval bench datasets/generated/moving_complex.mcap --repeat 1 --json > runs/bench/moving_complex.json
+	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
+
 test: $(STAMP)
 	$(BIN)/python -m pytest -q
 

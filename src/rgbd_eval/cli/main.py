@@ -5,6 +5,7 @@ from __future__ import annotations
 import typer
 
 from rgbd_eval import __version__
+from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.reproduce_cmd import reproduce
@@ -25,6 +26,7 @@ app.command("inspect")(inspect)
 app.command("compare")(compare)
 app.command("synth")(synth)
 app.command("reproduce")(reproduce)
+app.command("bench")(bench)
 
 
 def _version(value: bool) -> None:

@@ -45,7 +45,7 @@ from rgbd_eval.track.association import (
     mahalanobis_sq,
     score_assign,
 )
-from rgbd_eval.track.boosting import OnlineBoostingClassifier
+from rgbd_eval.track.boosting import OnlineBoostingClassifier, integral_histograms
 from rgbd_eval.track.motion import (
     apply_measurement,
     apply_transition,
@@ -192,8 +192,8 @@ class Basso2012Tracker:
         seen = [j for j in free if dets[j].appearance is not None]
         if not candidates or not seen:
             return free
-        hists = np.stack([_appearance(dets[j]) for j in seen])
-        scores = np.stack([_classifier(t).predict(hists) for t in candidates])
+        cums = self._integrals([dets[j] for j in seen])
+        scores = np.stack([_classifier(t).predict_integrals(cums) for t in candidates])
         for i, j in score_assign(scores, self._cfg.min_prediction):
             candidates[i].detection = seen[j]
             candidates[i].by_classifier = True
@@ -291,8 +291,8 @@ class Basso2012Tracker:
         ]
         if not lost:
             return
-        hists = np.stack([_appearance(dets[_det(self._tracks[i])]) for i in young])
-        scores = np.stack([_classifier(self._tracks[i]).predict(hists) for i in lost])
+        cums = self._integrals([dets[_det(self._tracks[i])] for i in young])
+        scores = np.stack([_classifier(self._tracks[i]).predict_integrals(cums) for i in lost])
         drop: list[int] = []
         for a, b in score_assign(scores, self._cfg.min_prediction):
             old, new = self._tracks[lost[a]], self._tracks[young[b]]
@@ -313,12 +313,20 @@ class Basso2012Tracker:
             and not dets[t.detection].occluded
             and dets[t.detection].appearance is not None
         ]
-        for t in usable:
+        if not usable:
+            return
+        cums = self._integrals([dets[_det(t)] for t in usable])
+        for a, t in enumerate(usable):
             classifier = _classifier(t)
-            classifier.update(_appearance(dets[_det(t)]), True)
-            for other in usable:
-                if other is not t:
-                    classifier.update(_appearance(dets[_det(other)]), False)
+            classifier.learn(cums[a], True)
+            for b in range(len(usable)):
+                if b != a:
+                    classifier.learn(cums[b], False)
+
+    def _integrals(self, dets: list[Detection]) -> Array:
+        """Integral colour histograms of detections, shared by every track's classifier."""
+        hists = np.asarray(np.stack([_appearance(d) for d in dets]), dtype=np.float64)
+        return np.stack([integral_histograms(h, self._bins) for h in hists])
 
     def _manage(self, stamp_ns: int) -> None:
         """Discard unvalidated tracks past ``frames_before_fake``; drop forgotten ones (6.4.4)."""

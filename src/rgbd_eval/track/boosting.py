@@ -21,8 +21,18 @@ Oza and Russell's on-line boosting (ref. [20]):
 - The strong classifier is ``H(x) = sum_n alpha_n h_n(x)`` (its confidence is
   compared against ``min_prediction``, Table 6.1).
 
-Vectorisation: each selector's step is a few array operations over the whole
-pool; only the importance recursion over the selectors is a Python loop.
+Speed: the importance recursion over the selectors is sequential, but the choices
+rarely change from one sample to the next. An update guesses the previous choices,
+runs the scalar recursion along them in plain Python floats, and checks all
+selectors with one masked argmin over the pool; only from the first wrong guess on
+(mostly among the last, weakest selectors) does it fall back to the step-by-step
+loop. Every weight is computed by the same floating-point operations either way,
+so the results are those of the plain loop, bit for bit
+(``tests/track/test_boosting_speed_equivalence.py`` keeps the plain implementation
+as the reference). The integral histogram of a sample does not depend on the
+classifier: :meth:`OnlineBoostingClassifier.learn` and
+:meth:`OnlineBoostingClassifier.predict_integrals` take it precomputed, so a
+tracker computes it once per detection for all its classifiers.
 """
 
 from __future__ import annotations
@@ -75,6 +85,17 @@ def box_corners(boxes: IntArray, bins: int) -> IntArray:
     return np.asarray((c[..., 0] * side + c[..., 1]) * side + c[..., 2], dtype=np.int64)
 
 
+def _one_box_corners(box: list[list[int]], bins: int) -> list[int]:
+    """:func:`box_corners` of one box ``[[r0, r1], [g0, g1], [b0, b1]]`` with Python ints."""
+    side = bins + 1
+    (r0, r1), (g0, g1), (b0, b1) = box
+    out: list[int] = []
+    for r in (r0, r1 + 1):
+        for g in (g0, g1 + 1):
+            out.extend(((r * side + g) * side + b0, (r * side + g) * side + b1 + 1))
+    return out
+
+
 def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
     """Zero-padded cumulative sums ``(..., (bins+1)**3)`` of flattened ``bins**3`` histograms."""
     lead = histograms.shape[:-1]
@@ -82,6 +103,25 @@ def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[n
     out = np.zeros((*lead, bins + 1, bins + 1, bins + 1))
     out[..., 1:, 1:, 1:] = cube.cumsum(-1).cumsum(-2).cumsum(-3)
     return out.reshape(*lead, (bins + 1) ** 3)
+
+
+def _recursion(
+    values: list[float], guess_correct: list[bool], totals: list[float]
+) -> tuple[list[float], list[float]]:
+    """Oza's importance along guessed choices: each selector's lambda and weighted error.
+
+    ``values`` are the chosen hypotheses' wrong weights before the sample,
+    ``guess_correct`` whether they are right on it, ``totals`` the selectors' totals.
+    """
+    lam = 1.0
+    lams: list[float] = []
+    errors: list[float] = []
+    for w, ok, total in zip(values, guess_correct, totals, strict=True):
+        e = (w if ok else w + lam) / (total + lam)
+        lams.append(lam)
+        errors.append(e)
+        lam = lam / (2.0 * (1.0 - e)) if ok else lam / (2.0 * e)
+    return lams, errors
 
 
 class OnlineBoostingClassifier:
@@ -126,7 +166,12 @@ class OnlineBoostingClassifier:
         self._wrong = np.full((N, M), _INITIAL_WEIGHT)
         self._total = np.full(N, 2.0 * _INITIAL_WEIGHT)
         self._selected = np.zeros(N, dtype=np.int64)
-        self._alpha = np.zeros(N)
+        self._alpha: Array | None = np.zeros(N)  # None: derive from _errors when needed
+        self._errors: list[float] = []
+        # _boost's check: flat indices of (selector n, column of the choice of selector k < n)
+        self._rows = np.arange(N)
+        taken_rows, self._taken_by = np.tril_indices(N, -1)
+        self._taken_base = taken_rows * M
         self.positives = 0
         self.negatives = 0
 
@@ -143,7 +188,7 @@ class OnlineBoostingClassifier:
     @property
     def alpha(self) -> Array:
         """Votes of the selectors (a copy)."""
-        return self._alpha.copy()
+        return self._votes().copy()
 
     def features(self, histograms: Histograms) -> Array:
         """Feature values ``(weak_classifiers,)`` or ``(D, weak_classifiers)`` of histograms."""
@@ -159,14 +204,27 @@ class OnlineBoostingClassifier:
         """
         h = self._check(histograms)
         if h.ndim == 2:
-            return np.array([self._confidence(row) for row in h])
-        return np.asarray(self._confidence(h), dtype=np.float64)
+            return np.array([self._confidence(integral_histograms(row, self.bins)) for row in h])
+        return np.asarray(self._confidence(integral_histograms(h, self.bins)), dtype=np.float64)
+
+    def predict_integrals(self, integrals: Array) -> Array:
+        """:meth:`predict` of a batch given as :func:`integral_histograms` ``(D, (bins+1)**3)``.
+
+        The integral of a histogram does not depend on the classifier: compute it once
+        when several classifiers of the same ``bins`` look at the same histogram.
+        """
+        return np.array([self._confidence(row) for row in integrals])
 
     def update(self, histogram: Histograms, positive: bool) -> None:
         """Learn one labelled sample (importance 1)."""
-        f = self.features(histogram)
-        if f.ndim != 1:
-            raise ValueError(f"update takes one histogram of shape ({self.size},), got {f.shape}")
+        h = self._check(histogram)
+        if h.ndim != 1:
+            raise ValueError(f"update takes one histogram of shape ({self.size},), got {h.shape}")
+        self.learn(integral_histograms(h, self.bins), positive)
+
+    def learn(self, integral: Array, positive: bool) -> None:
+        """:meth:`update` given the sample's :func:`integral_histograms` ``((bins+1)**3,)``."""
+        f = np.asarray(integral.take(self._corners) @ CORNER_SIGNS, dtype=np.float64)
         k = 1 if positive else 0
         gain = np.maximum(1.0 / (self._count[k] + 1.0), self._rate)
         self._mean[k] += gain * (f - self._mean[k])
@@ -181,10 +239,11 @@ class OnlineBoostingClassifier:
 
     # ------------------------------------------------------------------ internals
 
-    def _confidence(self, h: Array) -> float:
+    def _confidence(self, integral: Array) -> float:
         sel = self._selected
-        says_pos = self._hypotheses(self._box_sums(h, self._corners[sel]), sel)
-        return float(np.where(says_pos, 1.0, -1.0) @ self._alpha)
+        f = np.asarray(integral.take(self._corners[sel]) @ CORNER_SIGNS, dtype=np.float64)
+        says_pos = self._hypotheses(f, sel)
+        return float(np.where(says_pos, 1.0, -1.0) @ self._votes())
 
     def _box_sums(self, h: Array, corners: IntArray) -> Array:
         """Mass of one histogram ``(bins**3,)`` in the boxes given by their corners."""
@@ -208,32 +267,95 @@ class OnlineBoostingClassifier:
         return np.asarray(np.where(pos >= neg, f > threshold, f < threshold), dtype=bool)
 
     def _boost(self, correct: NDArray[np.bool_]) -> None:
-        """Selectors in turn: weigh the pool, take the best free hypothesis, pass lambda on."""
-        N = self._wrong.shape[0]
+        """Selectors in turn: weigh the pool, take the best free hypothesis, pass lambda on.
+
+        The choices are those of the plain sequential recursion (:meth:`_boost_from`),
+        found faster: guess that every selector takes the same hypothesis as on the
+        previous sample, run the scalar importance recursion along that guess, and check
+        every selector at once (one masked argmin over the pool). If each selector's
+        argmin is its guess, the guess is the recursion's result (by induction over the
+        selectors). Otherwise the selectors before the first mismatch are right, the
+        mismatched one is right with its argmin, and the sequential loop finishes from
+        there. Every weight is computed by the same floating-point operations as in the
+        sequential loop, so the results are the same bit for bit.
+        """
+        W = self._wrong
         miss = (~correct).astype(np.float64)
         is_correct = correct.tolist()
-        # scratch copy: row n becomes the wrong weights after this sample; hypotheses taken
-        # by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact in any order.
-        work = self._wrong.copy()
-        rows = list(work)
-        chosen = [0] * N
-        errors = [0.0] * N
-        lams = [0.0] * N
-        total = self._total.tolist()
-        lam = 1.0
-        for n in range(N):  # Oza's importance recursion; each step vectorised over the pool
-            row = blas.daxpy(miss, rows[n], a=lam)  # in place: row += lam * miss
-            m = int(row.argmin())
-            e = float(row[m]) / (total[n] + lam)
-            work[n + 1 :, m] = np.inf
-            chosen[n], errors[n], lams[n] = m, e, lam
-            lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)
-        lam_arr = np.asarray(lams)
-        self._wrong += np.multiply.outer(lam_arr, miss)
-        self._total += lam_arr
-        err = np.asarray(errors)
-        self._selected = np.asarray(chosen, dtype=np.int64)
-        self._alpha = np.where(err < 0.5, 0.5 * np.log((1.0 - err) / err), 0.0)
+        guess = self._selected
+        totals = self._total.tolist()
+        lams, errors = _recursion(
+            W[self._rows, guess].tolist(), [is_correct[m] for m in guess.tolist()], totals
+        )
+        new_wrong = W + np.multiply.outer(np.asarray(lams), miss)
+        masked = new_wrong.copy()
+        masked.ravel()[self._taken_base + guess[self._taken_by]] = np.inf
+        best = masked.argmin(axis=1)
+        mismatched = np.flatnonzero(best != guess)
+        if len(mismatched) == 0:
+            self._finish(new_wrong, np.asarray(lams), errors, guess.copy())
+            return
+        # selectors before p took their guess; selector p takes its masked argmin
+        p = int(mismatched[0])
+        chosen = [*guess[:p].tolist(), int(best[p])]
+        lam = lams[p]
+        e = float(new_wrong[p, chosen[p]]) / (totals[p] + lam)
+        errors[p] = e
+        lam_next = lam / (2.0 * (1.0 - e)) if is_correct[chosen[p]] else lam / (2.0 * e)
+        del lams[p + 1 :], errors[p + 1 :]
+        self._boost_from(new_wrong, chosen, lams, errors, lam_next, miss, is_correct)
+
+    def _boost_from(
+        self,
+        new_wrong: Array,
+        chosen: list[int],
+        lams: list[float],
+        errors: list[float],
+        lam: float,
+        miss: Array,
+        is_correct: list[bool],
+    ) -> None:
+        """The sequential recursion from selector ``start = len(chosen)`` on, lambda ``lam``.
+
+        The earlier selectors' choices, lambdas, errors and rows of ``new_wrong`` are
+        given; the rest are filled in.
+        """
+        N = self._wrong.shape[0]
+        start = len(chosen)
+        if start < N:
+            # scratch copy: row n becomes the wrong weights after this sample; hypotheses
+            # taken by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact.
+            work = self._wrong[start:].copy()
+            work[:, chosen] = np.inf
+            rows = list(work)
+            total = self._total.tolist()
+            for n in range(start, N):  # each step vectorised over the pool
+                row = blas.daxpy(miss, rows[n - start], a=lam)  # in place: row += lam * miss
+                m = int(row.argmin())
+                e = float(row[m]) / (total[n] + lam)
+                work[n - start + 1 :, m] = np.inf
+                chosen.append(m)
+                errors.append(e)
+                lams.append(lam)
+                lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)
+            tail = np.asarray(lams[start:])
+            new_wrong[start:] = self._wrong[start:] + np.multiply.outer(tail, miss)
+        self._finish(new_wrong, np.asarray(lams), errors, np.asarray(chosen, dtype=np.int64))
+
+    def _finish(self, wrong: Array, lams: Array, errors: list[float], chosen: IntArray) -> None:
+        """Store a sample's new weights, choices and votes."""
+        self._wrong = wrong
+        self._total += lams
+        self._errors = errors
+        self._selected = chosen
+        self._alpha = None  # only predictions need the votes: derived on demand
+
+    def _votes(self) -> Array:
+        """``alpha_n = 1/2 ln((1 - e_n)/e_n)``, 0 when ``e_n >= 1/2``, of the last sample's errors."""
+        if self._alpha is None:
+            err = np.asarray(self._errors)
+            self._alpha = np.where(err < 0.5, 0.5 * np.log((1.0 - err) / err), 0.0)
+        return self._alpha
 
     def _exchange_worst(self) -> None:
         mean_error = (1.0 / (len(self._total) * self._total)) @ self._wrong
@@ -247,7 +369,7 @@ class OnlineBoostingClassifier:
         box = self._spare_boxes[self._spare_next]
         self._spare_next += 1
         self._boxes[m] = box
-        self._corners[m] = box_corners(box[None], self.bins)[0]
+        self._corners[m] = _one_box_corners(box.tolist(), self.bins)
         self._mean[:, m] = 0.0
         self._count[:, m] = 0.0
         self._wrong[:, m] = self._wrong @ self._mean_weights

@@ -1,0 +1,286 @@
+"""Benchmark the pipeline stage by stage on one recording, against the floor of decoding it.
+
+One repeat streams the recording once, frame by frame, through a fresh detector and
+tracker (memory stays flat), then scores it when ground truth exists. Every stage is
+timed on its own: ``index`` (the index pass: topic choice, RGB/depth pairing, tf),
+``decode`` (reading and decoding each frame), the detector's own stages (for
+basso2012 ``pointcloud``, ``voxel``, ``ground``, ``clustering``, ``subclustering``,
+``features``, ``hog``, and ``detections`` for the rest of its call), ``track``,
+``score`` (loading the ground truth, matching, CLEAR MOT) and ``other`` (loop
+overhead: whatever the others do not cover), so the stages of one repeat sum to its
+wall time. The floor is the same recording read and decoded alone
+(:func:`rgbd_eval.io.benchmark.time_read`). Figures are medians over repeats, per
+frame. No printing.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import statistics
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from rgbd_eval.config import RunConfig
+from rgbd_eval.detect.protocol import create_detector
+from rgbd_eval.errors import ConfigError, InputError
+from rgbd_eval.io.benchmark import time_read
+from rgbd_eval.io.reader import open_recording
+from rgbd_eval.pipeline import find_ground_truth, match_ground_truth, score_sequence
+from rgbd_eval.track.protocol import create_tracker
+from rgbd_eval.types import TrackOutput
+
+SCHEMA_VERSION = 1
+
+#: Stages before and after detection, in pipeline order.
+READ_STAGES = ("index", "decode")
+LATE_STAGES = ("track", "score", "other")
+#: The detector's call, for a detector that does not time its own stages.
+DETECT_STAGE = "detect"
+#: The part of a self-timing detector's call outside its named stages.
+DETECT_REST = "detections"
+
+#: Called after each frame with (frames done, frames in all repeats).
+Progress = Callable[[int, int], None]
+
+
+@runtime_checkable
+class TimedDetector(Protocol):
+    """A detector that records the seconds of each stage of its last call."""
+
+    last_timings: dict[str, float]
+
+
+@dataclass(frozen=True)
+class BenchResult:
+    """Per-frame timings of one recording (medians over repeats)."""
+
+    schema_version: int
+    path: str
+    method: str
+    frames: int
+    repeats: int
+    rgb_size: tuple[int, int]
+    depth_size: tuple[int, int]
+    detections_per_frame: float
+    tracks_per_frame: float
+    scored: bool
+    #: Median milliseconds per frame of each stage, in pipeline order.
+    stage_ms: dict[str, float]
+    #: Milliseconds per frame of the whole pipeline, each repeat (wall clock).
+    total_ms_repeats: tuple[float, ...]
+    #: Milliseconds per frame to index and decode the recording alone, each repeat.
+    floor_ms_repeats: tuple[float, ...]
+    #: Milliseconds per frame to iterate the image messages' raw bytes (median).
+    raw_ms: float
+    raw_reader: str
+    #: Peak resident set size of this process so far (MiB).
+    peak_rss_mib: float
+    openblas_threads: str | None
+
+    @property
+    def total_ms(self) -> float:
+        """Median milliseconds per frame of the whole pipeline."""
+        return statistics.median(self.total_ms_repeats)
+
+    @property
+    def fps(self) -> float:
+        """Frames per second of the whole pipeline (median repeat)."""
+        return 1e3 / self.total_ms
+
+    @property
+    def floor_ms(self) -> float:
+        """Median milliseconds per frame to index and decode alone."""
+        return statistics.median(self.floor_ms_repeats)
+
+    @property
+    def floor_fps(self) -> float:
+        """Frames per second of decoding alone: no pipeline can be faster."""
+        return 1e3 / self.floor_ms
+
+    @property
+    def ratio(self) -> float:
+        """Pipeline time over decode-only time (1 would mean processing is free)."""
+        return self.total_ms / self.floor_ms
+
+    def stage_fps(self, stage: str) -> float:
+        """Frames per second of one stage alone (``inf`` when it took no time)."""
+        ms = self.stage_ms[stage]
+        return 1e3 / ms if ms > 0.0 else float("inf")
+
+    def to_json(self) -> dict[str, object]:
+        """A JSON-ready dict, derived figures included."""
+        return {
+            "schema_version": self.schema_version,
+            "path": self.path,
+            "method": self.method,
+            "frames": self.frames,
+            "repeats": self.repeats,
+            "rgb_size": list(self.rgb_size),
+            "depth_size": list(self.depth_size),
+            "detections_per_frame": self.detections_per_frame,
+            "tracks_per_frame": self.tracks_per_frame,
+            "scored": self.scored,
+            "stage_ms": dict(self.stage_ms),
+            "total_ms": self.total_ms,
+            "fps": self.fps,
+            "total_ms_repeats": list(self.total_ms_repeats),
+            "floor_ms": self.floor_ms,
+            "floor_fps": self.floor_fps,
+            "floor_ms_repeats": list(self.floor_ms_repeats),
+            "ratio": self.ratio,
+            "raw_ms": self.raw_ms,
+            "raw_reader": self.raw_reader,
+            "peak_rss_mib": self.peak_rss_mib,
+            "openblas_threads": self.openblas_threads,
+        }
+
+
+@dataclass(frozen=True)
+class _Repeat:
+    frames: int
+    seconds: dict[str, float]
+    wall_s: float
+    detections: int
+    tracks: int
+    scored: bool
+    rgb_size: tuple[int, int]
+    depth_size: tuple[int, int]
+
+
+def peak_rss_mib() -> float:
+    """Peak resident set size of this process (MiB; Linux reports KiB, macOS bytes)."""
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / 1024.0 if os.uname().sysname != "Darwin" else peak / 2.0**20
+
+
+def _add(seconds: dict[str, float], stage: str, value: float) -> None:
+    seconds[stage] = seconds.get(stage, 0.0) + value
+
+
+def _one_repeat(
+    path: Path, config: RunConfig, done: int, total: int, progress: Progress | None
+) -> _Repeat:
+    """Stream the recording once through detector, tracker and scorer, timing each stage."""
+    seconds: dict[str, float] = dict.fromkeys(READ_STAGES, 0.0)
+    wall = time.perf_counter()
+    recording = open_recording(path, config.io)
+    seconds["index"] = time.perf_counter() - wall
+    start = time.perf_counter()
+    gt = find_ground_truth(path, recording, None)
+    gt_s = time.perf_counter() - start
+    detector = create_detector(config.method, config)
+    tracker = create_tracker(config.method, config)
+    stamps: list[int] = []
+    tracks: list[tuple[TrackOutput, ...]] = []
+    detections = 0
+    rgb_size = depth_size = (0, 0)
+    start = time.perf_counter()
+    for frame in recording.frames():
+        t0 = time.perf_counter()
+        seconds["decode"] += t0 - start
+        dets = detector.detect(frame)
+        t1 = time.perf_counter()
+        if isinstance(detector, TimedDetector):
+            stages = detector.last_timings
+            for stage, value in stages.items():
+                _add(seconds, stage, value)
+            _add(seconds, DETECT_REST, max(0.0, (t1 - t0) - sum(stages.values())))
+        else:
+            _add(seconds, DETECT_STAGE, t1 - t0)
+        tracks.append(tuple(tracker.update(frame.stamp_ns, dets)))
+        start = time.perf_counter()
+        _add(seconds, "track", start - t1)
+        stamps.append(frame.stamp_ns)
+        detections += len(dets)
+        rgb_size = (frame.rgb.shape[1], frame.rgb.shape[0])
+        depth_size = (frame.depth.shape[1], frame.depth.shape[0])
+        if progress is not None:
+            progress(done + len(stamps), total)
+    start = time.perf_counter()
+    scored = gt is not None
+    if gt is not None:
+        score_sequence(match_ground_truth(gt, stamps, config), tracks, config)
+    seconds["score"] = gt_s + time.perf_counter() - start
+    wall_s = time.perf_counter() - wall
+    seconds["other"] = max(0.0, wall_s - sum(seconds.values()))
+    return _Repeat(
+        frames=len(stamps),
+        seconds=seconds,
+        wall_s=wall_s,
+        detections=detections,
+        tracks=sum(len(t) for t in tracks),
+        scored=scored,
+        rgb_size=rgb_size,
+        depth_size=depth_size,
+    )
+
+
+def _stage_order(stages: set[str]) -> list[str]:
+    middle = sorted(stages - set(READ_STAGES) - set(LATE_STAGES), key=_detector_rank)
+    return [*READ_STAGES, *middle, *LATE_STAGES]
+
+
+def _detector_rank(stage: str) -> tuple[int, str]:
+    from rgbd_eval.detect.basso2012 import STAGES
+
+    order = (*STAGES, DETECT_REST, DETECT_STAGE)
+    return (order.index(stage), stage) if stage in order else (len(order), stage)
+
+
+def benchmark(
+    path: Path | str,
+    config: RunConfig,
+    repeats: int = 3,
+    progress: Progress | None = None,
+) -> BenchResult:
+    """Time every stage of the configured pipeline on ``path``, ``repeats`` times, and the floor.
+
+    Raises the package's errors for a bad recording or config (InputError, ConfigError, ...).
+    """
+    if repeats < 1:
+        raise ConfigError(f"repeat={repeats} must be >= 1")
+    path = Path(path)
+    runs: list[_Repeat] = []
+    floors: list[float] = []
+    raws: list[float] = []
+    raw_reader = ""
+    for _ in range(repeats):
+        # decode-only floor first, then the pipeline: both see the same cache state
+        read = time_read(path, config.io)
+        if read.frames == 0:
+            raise InputError(path, "no synchronised RGB/depth frames to benchmark")
+        frames = read.frames
+        total = frames * repeats
+        floors.append((read.index_s + read.frames_s) * 1e3 / frames)
+        raws.append(read.raw_floor_s * 1e3 / frames)
+        raw_reader = read.raw_floor_reader
+        runs.append(_one_repeat(path, config, len(runs) * frames, total, progress))
+    frames = runs[0].frames
+    stages = _stage_order({s for r in runs for s in r.seconds})
+    stage_ms = {
+        s: statistics.median(r.seconds.get(s, 0.0) * 1e3 / frames for r in runs) for s in stages
+    }
+    first = runs[0]
+    return BenchResult(
+        schema_version=SCHEMA_VERSION,
+        path=str(path),
+        method=config.method,
+        frames=frames,
+        repeats=repeats,
+        rgb_size=first.rgb_size,
+        depth_size=first.depth_size,
+        detections_per_frame=first.detections / frames,
+        tracks_per_frame=first.tracks / frames,
+        scored=first.scored,
+        stage_ms=stage_ms,
+        total_ms_repeats=tuple(r.wall_s * 1e3 / frames for r in runs),
+        floor_ms_repeats=tuple(floors),
+        raw_ms=statistics.median(raws),
+        raw_reader=raw_reader,
+        peak_rss_mib=peak_rss_mib(),
+        openblas_threads=os.environ.get("OPENBLAS_NUM_THREADS"),
+    )

@@ -1,0 +1,115 @@
+"""``rgbd-eval bench``: frames per second and milliseconds per stage, against the decode floor."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated
+
+import typer
+from rich.table import Table
+
+from rgbd_eval.cli.common import advance_callback, console, handle_errors, progress_bar
+from rgbd_eval.config import load_config
+
+if TYPE_CHECKING:
+    from rgbd_eval.bench import BenchResult
+
+#: Human names of the stages.
+STAGE_LABELS = {
+    "index": "index + sync",
+    "decode": "read + decode",
+    "pointcloud": "point cloud",
+    "voxel": "voxel grid",
+    "ground": "ground plane",
+    "clustering": "clustering",
+    "subclustering": "sub-clustering",
+    "features": "features",
+    "hog": "HOG",
+    "detections": "detections (rest)",
+    "detect": "detection",
+    "track": "tracking",
+    "score": "scoring",
+    "other": "other (loop)",
+}
+
+
+def print_bench(result: BenchResult) -> None:
+    """The human table: per-stage milliseconds, fps, and the decode floor."""
+    (rw, rh), (dw, dh) = result.rgb_size, result.depth_size
+    table = Table(
+        title=(
+            f"{result.method} on {Path(result.path).name}: {result.frames} frames, "
+            f"RGB {rw}x{rh}, depth {dw}x{dh}"
+        ),
+        title_justify="left",
+        min_width=76,
+    )
+    table.add_column("stage")
+    table.add_column("ms/frame", justify="right")
+    table.add_column("share", justify="right")
+    table.add_column("fps alone", justify="right")
+    for stage, ms in result.stage_ms.items():
+        fps = result.stage_fps(stage)
+        table.add_row(
+            STAGE_LABELS.get(stage, stage),
+            f"{ms:.3f}",
+            f"{100.0 * ms / result.total_ms:.1f}%",
+            "-" if fps == float("inf") else f"{fps:.0f}",
+        )
+    table.add_row(
+        "pipeline",
+        f"{result.total_ms:.3f}",
+        "",
+        f"{result.fps:.1f}",
+        style="bold",
+        end_section=True,
+    )
+    table.add_row("decode alone (floor)", f"{result.floor_ms:.3f}", "", f"{result.floor_fps:.1f}")
+    table.add_row(f"raw bytes ({result.raw_reader})", f"{result.raw_ms:.3f}", "", "")
+    console.print(table)
+    threads = result.openblas_threads or "unset"
+    console.print(
+        f"median of {result.repeats} repeat{'s' if result.repeats > 1 else ''}; "
+        f"pipeline/floor = {result.ratio:.2f}; {result.detections_per_frame:.2f} detections and "
+        f"{result.tracks_per_frame:.2f} tracks per frame; "
+        f"{'scored' if result.scored else 'no ground truth, scoring not timed'}; "
+        f"peak RSS {result.peak_rss_mib:.0f} MiB; OPENBLAS_NUM_THREADS={threads}"
+    )
+
+
+@handle_errors
+def bench(
+    path: Annotated[
+        Path | None, typer.Argument(help="recording to time (default: the demo)")
+    ] = None,
+    method: Annotated[
+        str | None, typer.Option(help="detector/tracker pairing (default: basso2012)")
+    ] = None,
+    repeat: Annotated[int, typer.Option(help="repeats; figures are medians")] = 3,
+    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
+    overrides: Annotated[
+        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
+    ] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="print the result as JSON instead of a table")
+    ] = False,
+) -> None:
+    """Time each pipeline stage on one recording, against the floor of decoding it alone.
+
+    Run with OPENBLAS_NUM_THREADS=1 for one-core figures.
+    """
+    from rgbd_eval.bench import benchmark  # heavy imports only when needed
+    from rgbd_eval.cli.run import ensure_demo
+
+    config = load_config(
+        config_file, overrides or [], method=method or (None if config_file else "basso2012")
+    )
+    target = path if path is not None else ensure_demo()
+    with progress_bar() as bar:
+        task = bar.add_task(f"bench {target.name}", total=None)
+        result = benchmark(target, config, repeat, advance_callback(bar, task))
+    if json_out:
+        typer.echo(json.dumps(result.to_json(), indent=2))
+    else:
+        print_bench(result)
