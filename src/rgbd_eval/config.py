@@ -276,7 +276,7 @@ class RunConfig(_Model):
 # ----------------------------------------------------------------------------- loading
 
 
-def _format_validation_error(err: ValidationError, source: str) -> str:
+def format_validation_error(err: ValidationError, source: str) -> str:
     parts = []
     for e in err.errors():
         loc = ".".join(str(p) for p in e["loc"])
@@ -350,7 +350,7 @@ def build_config(
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as err:
-        raise ConfigError(_format_validation_error(err, source)) from err
+        raise ConfigError(format_validation_error(err, source)) from err
 
 
 def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:

@@ -17,7 +17,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from rgbd_eval.config import _format_validation_error, load_yaml, repo_root
+from rgbd_eval.config import format_validation_error, load_yaml, repo_root
 from rgbd_eval.errors import ConfigError
 
 Colour = tuple[int, int, int]
@@ -378,7 +378,7 @@ def parse_scenario(data: object, source: str = "scenario") -> Scenario:
     try:
         return Scenario.model_validate(data)
     except ValidationError as err:
-        raise ConfigError(_format_validation_error(err, source)) from err
+        raise ConfigError(format_validation_error(err, source)) from err
 
 
 def load_scenario(path: Path | str) -> Scenario:
