@@ -271,8 +271,8 @@ def check_claims(res: Reproduction) -> list[Claim]:
         claims.append(
             Claim(
                 "7.3, Table 7.6",
-                "FN rise for thresholds above -0.5",
-                fn[0.5] > fn[-0.5],
+                "FN rise (by 2 points or more) for thresholds above -0.5",
+                fn[0.5] - fn[-0.5] >= 0.02,  # a rise of 2 points or more (thesis: 5.6% -> 13.0%)
                 f"FN {fn[-0.5]:.1%} at -0.5, {fn[0.5]:.1%} at 0.5",
             )
         )
