@@ -21,6 +21,11 @@ def known_names() -> list[str]:
     return sorted(p.stem for p in scenarios_dir().glob("*.yaml"))
 
 
+def dataset_folder(name: str) -> Path:
+    """The demo lives in ``datasets/``, the thesis scenarios in ``datasets/generated/``."""
+    return datasets_dir() if name == "demo" else datasets_dir() / "generated"
+
+
 def resolve(name_or_path: str) -> Path:
     """A path as is; a name (``moving_complex`` or ``thesis-moving-complex``) under ``datasets/``."""
     path = Path(name_or_path)
@@ -28,11 +33,13 @@ def resolve(name_or_path: str) -> Path:
         return path
     stem = name_or_path.removeprefix("thesis-").replace("-", "_")
     if stem in known_names():
-        candidate = datasets_dir() / f"{stem}.mcap"
-        if candidate.exists():
-            return candidate
+        folder = dataset_folder(stem)
+        for suffix in (".mcap", ".bag"):
+            if (folder / f"{stem}{suffix}").exists():
+                return folder / f"{stem}{suffix}"
         raise InputError(
-            candidate, f"dataset {name_or_path!r} is not generated yet; run `make datasets`"
+            folder / f"{stem}.mcap",
+            f"dataset {name_or_path!r} is not generated yet; run `make datasets`",
         )
     known = ", ".join(known_names()) or "none"
     raise InputError(path, f"no such file, and not a dataset name (known: {known})")
