@@ -21,6 +21,11 @@ def known_names() -> list[str]:
     return sorted(p.stem for p in scenarios_dir().glob("*.yaml"))
 
 
+def scenario_name(name_or_path: str) -> str:
+    """``thesis-moving-complex`` -> ``moving_complex``; other names unchanged."""
+    return name_or_path.removeprefix("thesis-").replace("-", "_")
+
+
 def dataset_folder(name: str) -> Path:
     """The demo lives in ``datasets/``, the thesis scenarios in ``datasets/generated/``."""
     return datasets_dir() if name == "demo" else datasets_dir() / "generated"
@@ -31,7 +36,7 @@ def resolve(name_or_path: str) -> Path:
     path = Path(name_or_path)
     if path.exists():
         return path
-    stem = name_or_path.removeprefix("thesis-").replace("-", "_")
+    stem = scenario_name(name_or_path)
     if stem in known_names():
         folder = dataset_folder(stem)
         for suffix in (".mcap", ".bag"):

@@ -12,17 +12,15 @@ from rgbd_eval.errors import ConfigError
 
 
 def _scenario_file(name_or_path: str) -> Path:
-    from rgbd_eval.sim import scenario_paths
+    from rgbd_eval.datasets import known_names, scenario_name, scenarios_dir
 
     path = Path(name_or_path)
     if path.exists():
         return path
-    by_name = {p.stem: p for p in scenario_paths()}
-    stem = name_or_path.removeprefix("thesis-").replace("-", "_")
-    if stem in by_name:
-        return by_name[stem]
+    if scenario_name(name_or_path) in known_names():
+        return scenarios_dir() / f"{scenario_name(name_or_path)}.yaml"
     raise ConfigError(
-        f"{name_or_path}: no such scenario file or name (known: {', '.join(sorted(by_name))})"
+        f"{name_or_path}: no such scenario file or name (known: {', '.join(known_names())})"
     )
 
 
