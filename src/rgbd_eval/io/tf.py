@@ -17,7 +17,9 @@ def slerp(q0: FloatArray, q1: FloatArray, t: float) -> FloatArray:
     dot = float(np.dot(q0, q1))
     if dot < 0.0:  # take the short way round
         q1, dot = -q1, -dot
-    if dot > 0.9995:  # nearly parallel: lerp is exact enough and stable
+    # Nearly parallel (angle < ~1.4e-5 rad): normalised lerp differs from slerp by ~angle^3,
+    # below 1e-14, and avoids dividing by sin(angle) ~ 0. A looser cut (e.g. 0.9995) errs by 1e-6.
+    if dot > 1.0 - 1e-10:
         q = q0 + t * (q1 - q0)
         lerped: FloatArray = q / np.linalg.norm(q)
         return lerped
