@@ -110,14 +110,18 @@ def match_ground_truth(
     return GroundTruthMatch(gt.source, frames, len(gt.frames), unmatched)
 
 
-def find_ground_truth(path: Path, recording: Recording, gt_path: Path | None) -> GroundTruth | None:
-    """An explicit file, else the ``<name>.gt.csv`` sidecar, else the ground-truth topic."""
+def ground_truth_file(path: Path, gt_path: Path | None) -> GroundTruth | None:
+    """An explicit file, else the ``<name>.gt.csv`` sidecar (no need to open the recording)."""
     if gt_path is not None:
         return load_ground_truth(gt_path)
     sidecar = sidecar_path(path)
-    if sidecar is not None:
-        return load_ground_truth(sidecar)
-    return recording.ground_truth_topic
+    return load_ground_truth(sidecar) if sidecar is not None else None
+
+
+def find_ground_truth(path: Path, recording: Recording, gt_path: Path | None) -> GroundTruth | None:
+    """An explicit file, else the ``<name>.gt.csv`` sidecar, else the ground-truth topic."""
+    gt = ground_truth_file(path, gt_path)
+    return gt if gt is not None else recording.ground_truth_topic
 
 
 def score_sequence(

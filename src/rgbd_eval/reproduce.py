@@ -98,10 +98,13 @@ def _sweep(
     return out
 
 
-def track_lengths(config: RunConfig, recording: Path, cache: Path | None) -> list[int]:
-    """Frames each distinct validated track is visible (Figure 7.7), from cached detections."""
+def track_lengths(config: RunConfig, recording: Path, digest: str, cache: Path | None) -> list[int]:
+    """Frames each distinct validated track is visible (Figure 7.7), from cached detections.
+
+    ``digest`` is the recording's :func:`file_digest`, computed once by the caller.
+    """
     store = DetectionCache(cache)
-    key = detection_key(file_digest(recording), config)
+    key = detection_key(digest, config)
     detections = store.load(key)
     if detections is None:  # not cached (or the file changed since): detect now
         detections = detect_sequence(open_recording(recording, config.io), config)
@@ -200,12 +203,13 @@ def reproduce_basso2012(
         if name not in recordings:
             continue
         res.track_lengths[name] = {}
+        digest = file_digest(recordings[name])
         for memory in MEMORY_SECONDS:
             overrides = [("tracker.classifier_memory_s", memory)]
             if memory == 0.0:
                 overrides.append(("tracker.classifier", False))  # 7.1: 0 s means no classifier
             cfg = build_config(base, overrides)
-            res.track_lengths[name][memory] = track_lengths(cfg, recordings[name], cache)
+            res.track_lengths[name][memory] = track_lengths(cfg, recordings[name], digest, cache)
 
     timing_seq = recordings.get("moving_complex") or next(iter(recordings.values()))
     say(f"Figure 7.9: detection time against voxel size on {timing_seq.stem}")

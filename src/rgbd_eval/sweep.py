@@ -25,7 +25,7 @@ from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,
     detect_sequence,
-    find_ground_truth,
+    ground_truth_file,
     match_ground_truth,
     score_sequence,
     sequence_name,
@@ -138,17 +138,21 @@ def _detect_job(
     start = time.perf_counter()
     cache = DetectionCache(cache_root)
     key = detection_key(digest, config)
-    recording = open_recording(path, config.io)
-    gt = find_ground_truth(path, recording, gt_path)
-    if gt is None:
-        raise ScoringError(
-            f"{path}: a sweep needs ground truth (topic, <name>.gt.csv sidecar or --gt)"
-        )
+    gt = ground_truth_file(path, gt_path)
     detections = cache.load(key)
     hit = detections is not None
-    if detections is None:
-        detections = detect_sequence(recording, config)
-        cache.store(key, detections)
+    if detections is None or gt is None:
+        # The index pass reads every image message: only when detecting or for a ground-truth topic.
+        recording = open_recording(path, config.io)
+        if gt is None:
+            gt = recording.ground_truth_topic
+        if gt is None:
+            raise ScoringError(
+                f"{path}: a sweep needs ground truth (topic, <name>.gt.csv sidecar or --gt)"
+            )
+        if detections is None:
+            detections = detect_sequence(recording, config)
+            cache.store(key, detections)
     matched = match_ground_truth(gt, detections.stamps_ns, config)
     return _Prepared(path, key, matched, time.perf_counter() - start, hit)
 
