@@ -39,9 +39,21 @@ def test_rgb8_bgr8_mono8(pad: int) -> None:
     )
     rgba = np.concatenate([RGB, np.full((4, 5, 1), 255, np.uint8)], axis=2)
     np.testing.assert_array_equal(images.decode_color(image_msg(rgba, "rgba8", pad=pad)), RGB)
+    bgra = np.concatenate([RGB[..., ::-1], np.full((4, 5, 1), 255, np.uint8)], axis=2)
+    np.testing.assert_array_equal(images.decode_color(image_msg(bgra, "bgra8", pad=pad)), RGB)
     mono = RGB[..., 0]
     out = images.decode_color(image_msg(mono, "mono8", pad=pad))
-    assert out.shape == (4, 5, 3) and np.array_equal(out[..., 2], mono)
+    assert out.shape == (4, 5, 3) and all(np.array_equal(out[..., c], mono) for c in range(3))
+
+
+def test_jpeg_decodes_to_rgb_order() -> None:
+    # Flat colour patches survive jpeg almost exactly; red must stay in channel 0.
+    rgb = np.zeros((16, 16, 3), np.uint8)
+    rgb[..., 0] = 200
+    rgb[..., 2] = 30
+    out = images.decode_color(SimpleNamespace(**images.encode_color_jpeg(rgb)))
+    assert out.shape == (16, 16, 3) and out.flags.c_contiguous
+    np.testing.assert_allclose(out.mean(axis=(0, 1)), [200, 0, 30], atol=3)
 
 
 @pytest.mark.parametrize("big_endian", [False, True])

@@ -11,6 +11,7 @@ import struct
 from collections.abc import Iterator
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
+from functools import lru_cache
 from pathlib import Path
 from types import TracebackType
 from typing import IO, Any
@@ -23,6 +24,7 @@ from rosbags.rosbag2 import ReaderError as Ros2ReaderError
 from rosbags.serde import SerdeError
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.base import TypesysError
+from rosbags.typesys.store import Typestore
 
 from rgbd_eval.io.messages import typestore
 
@@ -120,19 +122,18 @@ class McapSource(MessageSource):
         if summary is None:
             self._handle.close()
             raise McapError("no summary section (file truncated or written without an index)")
-        self.store = get_typestore(Stores.EMPTY)
-        self.store.register(typestore(2).fielddefs)
         counts = summary.statistics.channel_message_counts if summary.statistics else {}
         self.topics = {}
+        schemas: dict[str, bytes] = {}  # empty text: not ros2msg (e.g. ros2idl)
         for cid, channel in summary.channels.items():
             schema = summary.schemas.get(channel.schema_id)
             if schema is None or channel.message_encoding != "cdr":
                 continue
-            if schema.encoding == "ros2msg" and schema.name not in self.store.fielddefs:
-                self.store.register(get_types_from_msg(schema.data.decode(), schema.name))
+            schemas[schema.name] = schema.data if schema.encoding == "ros2msg" else b""
             self.topics[channel.topic] = TopicConnection(
                 channel.topic, schema.name, int(counts.get(cid, 0))
             )
+        self.store = _schema_store(tuple(sorted(schemas.items())))
         if summary.statistics is not None:
             self.start_ns = summary.statistics.message_start_time
             self.end_ns = summary.statistics.message_end_time
@@ -149,6 +150,28 @@ class McapSource(MessageSource):
 
     def close(self) -> None:
         self._handle.close()
+
+
+@lru_cache(maxsize=8)
+def _schema_store(schemas: tuple[tuple[str, bytes], ...]) -> Typestore:
+    """A typestore of just the file's ``ros2msg`` schemas (with their dependencies).
+
+    Registering a whole distribution's types builds hundreds of classes (~0.1-0.2 s),
+    more than decoding a short recording; a file's handful takes ~20 ms, and the
+    index and frame passes (and sweeps) of one file share it through the cache.
+    When a schema is not ``ros2msg`` or does not parse, all of ROS2 Humble's types
+    are registered too (deserialising a type found in neither fails, naming it).
+    """
+    store = get_typestore(Stores.EMPTY)
+    for name, data in schemas:
+        try:
+            types = get_types_from_msg(data.decode(), name) if data else {}
+        except (TypesysError, UnicodeDecodeError):
+            types = {}
+        if name not in types:
+            types = dict(typestore(2).fielddefs)
+        store.register({k: v for k, v in types.items() if k not in store.fielddefs})
+    return store
 
 
 def open_source(path: Path) -> MessageSource:
