@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import json
 import math
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -91,13 +94,22 @@ def test_bad_arguments_raise_package_errors(recording: Path, tmp_path: Path) -> 
 
 
 def test_cli_json_and_table(recording: Path) -> None:
-    out = runner.invoke(_app(), ["bench", str(recording), "--repeat", "1", "--json"])
+    out = runner.invoke(_app(), ["bench", str(recording), "--repeat", "1", "--json", "--all-cores"])
     assert out.exit_code == 0, out.output
     data = json.loads(out.output)
     assert data["schema_version"] == SCHEMA_VERSION and data["frames"] == FRAMES
     assert data["repeats"] == 1
     table = runner.invoke(
-        _app(), ["bench", str(recording), "--repeat", "1", "--set", "tracker.classifier=false"]
+        _app(),
+        [
+            "bench",
+            str(recording),
+            "--repeat",
+            "1",
+            "--all-cores",
+            "--set",
+            "tracker.classifier=false",
+        ],
     )
     assert table.exit_code == 0, table.output
     for label in (
@@ -107,8 +119,28 @@ def test_cli_json_and_table(recording: Path) -> None:
         "pipeline",
         "decode alone",
         "pipeline/floor",
+        "tracking alone",
     ):
         assert label in table.output
+
+
+def test_tracking_alone_is_timed(result: BenchResult) -> None:
+    assert result.track_alone_ms > 0.0
+    assert result.track_alone_fps == pytest.approx(1e3 / result.track_alone_ms)
+    assert result.to_json()["track_alone_fps"] == pytest.approx(result.track_alone_fps)
+
+
+def test_cli_pins_itself_to_one_cpu(recording: Path) -> None:
+    # In a child process: pinning the test process would slow the rest of the suite.
+    if not hasattr(os, "sched_setaffinity"):
+        pytest.skip("CPU affinity is not available on this platform")
+    out = subprocess.run(
+        [sys.executable, "-m", "rgbd_eval", "bench", str(recording), "--repeat", "1", "--json"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert len(json.loads(out.stdout)["cpus"]) == 1
 
 
 def test_cli_errors_are_one_line_with_exit_codes(recording: Path, tmp_path: Path) -> None:

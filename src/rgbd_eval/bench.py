@@ -9,8 +9,10 @@ basso2012 ``pointcloud``, ``voxel``, ``ground``, ``clustering``, ``subclustering
 ``score`` (loading the ground truth, matching, CLEAR MOT) and ``other`` (loop
 overhead: whatever the others do not cover), so the stages of one repeat sum to its
 wall time. The floor is the same recording read and decoded alone
-(:func:`rgbd_eval.io.benchmark.time_read`). Figures are medians over repeats, per
-frame. No printing.
+(:func:`rgbd_eval.io.benchmark.time_read`); *tracking alone* replays the repeat's
+detections, held in memory, through a fresh tracker. Figures are medians over
+repeats, per frame. By default the process is pinned to one CPU and OpenCV to one
+thread (:func:`one_core`), so the figures are one-core figures. No printing.
 """
 
 from __future__ import annotations
@@ -31,9 +33,9 @@ from rgbd_eval.io.benchmark import time_read
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.pipeline import find_ground_truth, match_ground_truth, score_sequence
 from rgbd_eval.track.protocol import create_tracker
-from rgbd_eval.types import TrackOutput
+from rgbd_eval.types import Detection, TrackOutput
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 #: Stages before and after detection, in pipeline order.
 READ_STAGES = ("index", "decode")
@@ -77,9 +79,13 @@ class BenchResult:
     #: Milliseconds per frame to iterate the image messages' raw bytes (median).
     raw_ms: float
     raw_reader: str
+    #: Milliseconds per frame of a fresh tracker fed the cached detections (median).
+    track_alone_ms: float
     #: Peak resident set size of this process so far (MiB).
     peak_rss_mib: float
     openblas_threads: str | None
+    #: CPUs the process was allowed to run on (None: not known on this platform).
+    cpus: tuple[int, ...] | None = None
 
     @property
     def total_ms(self) -> float:
@@ -105,6 +111,11 @@ class BenchResult:
     def ratio(self) -> float:
         """Pipeline time over decode-only time (1 would mean processing is free)."""
         return self.total_ms / self.floor_ms
+
+    @property
+    def track_alone_fps(self) -> float:
+        """Frames per second of tracking alone, from cached detections."""
+        return 1e3 / self.track_alone_ms if self.track_alone_ms > 0.0 else float("inf")
 
     def stage_fps(self, stage: str) -> float:
         """Frames per second of one stage alone (``inf`` when it took no time)."""
@@ -134,8 +145,11 @@ class BenchResult:
             "ratio": self.ratio,
             "raw_ms": self.raw_ms,
             "raw_reader": self.raw_reader,
+            "track_alone_ms": self.track_alone_ms,
+            "track_alone_fps": self.track_alone_fps,
             "peak_rss_mib": self.peak_rss_mib,
             "openblas_threads": self.openblas_threads,
+            "cpus": None if self.cpus is None else list(self.cpus),
         }
 
 
@@ -149,6 +163,36 @@ class _Repeat:
     scored: bool
     rgb_size: tuple[int, int]
     depth_size: tuple[int, int]
+    track_alone_s: float
+
+
+def one_core() -> tuple[int, ...] | None:
+    """Pin this process to one of its CPUs and OpenCV to one thread; the CPUs now allowed.
+
+    BLAS is single-threaded already (see :mod:`rgbd_eval.cli`). Where the platform
+    cannot pin (macOS), only OpenCV is limited and None is returned.
+    """
+    import cv2
+
+    cv2.setNumThreads(1)
+    if not hasattr(os, "sched_setaffinity"):
+        return None
+    os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
+    return tuple(sorted(os.sched_getaffinity(0)))
+
+
+def allowed_cpus() -> tuple[int, ...] | None:
+    """The CPUs this process may run on (None where the platform does not say)."""
+    return tuple(sorted(os.sched_getaffinity(0))) if hasattr(os, "sched_getaffinity") else None
+
+
+def time_tracking(config: RunConfig, stream: list[tuple[int, list[Detection]]]) -> float:
+    """Seconds for a fresh tracker to take ``(stamp, detections)`` frames in order."""
+    tracker = create_tracker(config.method, config)
+    start = time.perf_counter()
+    for stamp, dets in stream:
+        tracker.update(stamp, dets)
+    return time.perf_counter() - start
 
 
 def peak_rss_mib() -> float:
@@ -176,6 +220,7 @@ def _one_repeat(
     tracker = create_tracker(config.method, config)
     stamps: list[int] = []
     tracks: list[tuple[TrackOutput, ...]] = []
+    stream: list[tuple[int, list[Detection]]] = []
     detections = 0
     rgb_size = depth_size = (0, 0)
     start = time.perf_counter()
@@ -195,6 +240,7 @@ def _one_repeat(
         start = time.perf_counter()
         _add(seconds, "track", start - t1)
         stamps.append(frame.stamp_ns)
+        stream.append((frame.stamp_ns, dets))
         detections += len(dets)
         rgb_size = (frame.rgb.shape[1], frame.rgb.shape[0])
         depth_size = (frame.depth.shape[1], frame.depth.shape[0])
@@ -207,6 +253,7 @@ def _one_repeat(
     seconds["score"] = gt_s + time.perf_counter() - start
     wall_s = time.perf_counter() - wall
     seconds["other"] = max(0.0, wall_s - sum(seconds.values()))
+    track_alone_s = time_tracking(config, stream)
     return _Repeat(
         frames=len(stamps),
         seconds=seconds,
@@ -216,6 +263,7 @@ def _one_repeat(
         scored=scored,
         rgb_size=rgb_size,
         depth_size=depth_size,
+        track_alone_s=track_alone_s,
     )
 
 
@@ -281,6 +329,8 @@ def benchmark(
         floor_ms_repeats=tuple(floors),
         raw_ms=statistics.median(raws),
         raw_reader=raw_reader,
+        track_alone_ms=statistics.median(r.track_alone_s * 1e3 / frames for r in runs),
         peak_rss_mib=peak_rss_mib(),
         openblas_threads=os.environ.get("OPENBLAS_NUM_THREADS"),
+        cpus=allowed_cpus(),
     )

@@ -134,3 +134,16 @@ def test_readme_example_is_a_valid_scenario() -> None:
     block = text.split("```yaml\n", 1)[1].split("```", 1)[0]
     sc = parse_scenario(yaml.safe_load(block), "README")
     assert sc.people[1].follow is not None and sc.n_frames == 750
+
+
+def test_overrides_apply_to_nested_keys_and_are_validated() -> None:
+    demo = scenarios_dir() / "demo.yaml"
+    sc = load_scenario(demo, [("recording.rgb_format", "raw"), ("sensor.depth_decimation", 2)])
+    assert sc.recording.rgb_format == "raw" and sc.sensor.depth_decimation == 2
+    assert load_scenario(demo).recording.rgb_format == "jpeg"  # the file is untouched
+    with pytest.raises(ConfigError, match=r"recording\.nope: unknown key"):
+        load_scenario(demo, [("recording.nope", 1)])
+    with pytest.raises(ConfigError, match="rgb_format"):
+        load_scenario(demo, [("recording.rgb_format", "png")])
+    with pytest.raises(ConfigError, match="'duration_s' is not a mapping"):
+        load_scenario(demo, [("duration_s.x", 1)])

@@ -67,14 +67,21 @@ def print_bench(result: BenchResult) -> None:
     )
     table.add_row("decode alone (floor)", f"{result.floor_ms:.3f}", "", f"{result.floor_fps:.1f}")
     table.add_row(f"raw bytes ({result.raw_reader})", f"{result.raw_ms:.3f}", "", "")
+    table.add_row(
+        "tracking alone (cached detections)",
+        f"{result.track_alone_ms:.3f}",
+        "",
+        f"{result.track_alone_fps:.0f}",
+    )
     console.print(table)
     threads = result.openblas_threads or "unset"
+    cpus = "unknown" if result.cpus is None else ",".join(map(str, result.cpus))
     console.print(
         f"median of {result.repeats} repeat{'s' if result.repeats > 1 else ''}; "
         f"pipeline/floor = {result.ratio:.2f}; {result.detections_per_frame:.2f} detections and "
         f"{result.tracks_per_frame:.2f} tracks per frame; "
         f"{'scored' if result.scored else 'no ground truth, scoring not timed'}; "
-        f"peak RSS {result.peak_rss_mib:.0f} MiB; OPENBLAS_NUM_THREADS={threads}"
+        f"peak RSS {result.peak_rss_mib:.0f} MiB; OPENBLAS_NUM_THREADS={threads}; CPUs {cpus}"
     )
 
 
@@ -94,18 +101,24 @@ def bench(
     json_out: Annotated[
         bool, typer.Option("--json", help="print the result as JSON instead of a table")
     ] = False,
+    all_cores: Annotated[
+        bool,
+        typer.Option("--all-cores", help="do not pin to one CPU (OpenCV may use threads)"),
+    ] = False,
 ) -> None:
     """Time each pipeline stage on one recording, against the floor of decoding it alone.
 
-    Run with OPENBLAS_NUM_THREADS=1 for one-core figures.
+    One-core figures: the process is pinned to one CPU, OpenCV and BLAS to one thread.
     """
-    from rgbd_eval.bench import benchmark  # heavy imports only when needed
+    from rgbd_eval.bench import benchmark, one_core  # heavy imports only when needed
     from rgbd_eval.cli.run import ensure_demo
 
     config = load_config(
         config_file, overrides or [], method=method or (None if config_file else "basso2012")
     )
     target = path if path is not None else ensure_demo()
+    if not all_cores:
+        one_core()
     with progress_bar() as bar:
         task = bar.add_task(f"bench {target.name}", total=None)
         result = benchmark(target, config, repeat, advance_callback(bar, task))

@@ -30,7 +30,10 @@ def synth(
         str | None, typer.Argument(help="scenario YAML file or name (e.g. moving_complex)")
     ] = None,
     out: Annotated[Path | None, typer.Option("-o", "--out", help="output .mcap or .bag")] = None,
-    fmt: Annotated[str, typer.Option("--format", help="container: mcap or bag")] = "mcap",
+    fmt: Annotated[
+        str | None,
+        typer.Option("--format", help="container: mcap or bag (default: from --out, else mcap)"),
+    ] = None,
     seed: Annotated[int | None, typer.Option(help="random seed (default: the scenario's)")] = None,
     all_scenarios: Annotated[
         bool, typer.Option("--all", help="every scenario in configs/scenarios/")
@@ -39,12 +42,23 @@ def synth(
         Path | None, typer.Option(help="write a contact sheet PNG with ground-truth boxes")
     ] = None,
     frames: Annotated[int | None, typer.Option(help="render only the first N frames")] = None,
+    overrides: Annotated[
+        list[str] | None,
+        typer.Option("--set", help="scenario KEY=VALUE override, e.g. recording.rgb_format=raw"),
+    ] = None,
 ) -> None:
     """Render scenarios to ROS1 .bag or ROS2 .mcap plus a <name>.gt.csv sidecar; deterministic for a seed."""
+    from rgbd_eval.config import parse_overrides
     from rgbd_eval.sim import dataset_path, load_scenario, scenario_paths, synthesize, write_preview
 
+    changes = parse_overrides(overrides or [])
+
+    if fmt is None:
+        fmt = out.suffix[1:] if out is not None and out.suffix in (".mcap", ".bag") else "mcap"
     if fmt not in ("mcap", "bag"):
         raise ConfigError(f"--format {fmt!r}: expected mcap or bag")
+    if out is not None and out.suffix not in ("", f".{fmt}"):
+        raise ConfigError(f"--out {out}: a {fmt} recording needs a .{fmt} name")
     container: Literal["ros1", "mcap"] = "ros1" if fmt == "bag" else "mcap"
     if all_scenarios:
         if scenario is not None or out is not None or preview is not None:
@@ -60,11 +74,11 @@ def synth(
             out = dataset_path(path.stem, container)
         jobs = [(path, out)] if out is not None else []
         if preview is not None:
-            written = write_preview(load_scenario(path), preview, seed)
+            written = write_preview(load_scenario(path, changes), preview, seed)
             console.print(f"preview: {written}")
     with progress_bar() as bar:
         for scenario_path, target in jobs:
-            sc = load_scenario(scenario_path)
+            sc = load_scenario(scenario_path, changes)
             task = bar.add_task(scenario_path.stem, total=None)
             advance = advance_callback(bar, task)
             try:

@@ -83,7 +83,7 @@ def decode_color(msg: Any) -> NDArray[np.uint8]:
         if bgr is None:
             raise ImageFormatError(f"compressed image ({msg.format!r}) could not be decoded")
         # In place, and ~40x faster than copying the reversed-channel view.
-        return cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB, dst=bgr)
+        return np.asarray(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB, dst=bgr), dtype=np.uint8)
     if msg.encoding not in COLOR_ENCODINGS:
         raise ImageFormatError(
             f"expected a colour encoding ({', '.join(COLOR_ENCODINGS)}), got {msg.encoding!r}"
@@ -91,8 +91,7 @@ def decode_color(msg: Any) -> NDArray[np.uint8]:
     arr = image_array(msg)
     conversion = _TO_RGB.get(msg.encoding)
     if conversion is not None:
-        rgb: NDArray[np.uint8] = cv2.cvtColor(arr, conversion)
-        return rgb
+        return np.asarray(cv2.cvtColor(arr, conversion), dtype=np.uint8)
     return np.ascontiguousarray(arr[..., :3])
 
 

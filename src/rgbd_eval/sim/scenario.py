@@ -12,8 +12,9 @@ from __future__ import annotations
 
 import enum
 import math
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Literal
+from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -381,10 +382,26 @@ def parse_scenario(data: object, source: str = "scenario") -> Scenario:
         raise ConfigError(format_validation_error(err, source)) from err
 
 
-def load_scenario(path: Path | str) -> Scenario:
-    """Read and validate a scenario YAML file (raises :class:`ConfigError`)."""
+def load_scenario(path: Path | str, overrides: Iterable[tuple[str, Any]] = ()) -> Scenario:
+    """Read and validate a scenario YAML file, with dotted-key overrides (raises ConfigError).
+
+    ``overrides`` are ``(key, value)`` pairs such as ``("recording.rgb_format", "raw")``
+    (see :func:`rgbd_eval.config.parse_overrides`); validation names unknown keys.
+    """
     p = Path(path)
-    return parse_scenario(load_yaml(p), str(p))
+    data = load_yaml(p)
+    for key, value in overrides:
+        node = data
+        *parents, leaf = key.split(".")
+        for part in parents:
+            child = node.setdefault(part, {}) if isinstance(node, dict) else None
+            if not isinstance(child, dict):
+                raise ConfigError(f"{p}: override {key!r}: {part!r} is not a mapping")
+            node = child
+        if not isinstance(node, dict) or not leaf:
+            raise ConfigError(f"{p}: override {key!r}: not a mapping key")
+        node[leaf] = value
+    return parse_scenario(data, str(p))
 
 
 def scenarios_dir() -> Path:

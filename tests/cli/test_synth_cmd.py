@@ -1,0 +1,33 @@
+"""`rgbd-eval synth` from the command line: container choice, overrides, errors."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from rgbd_eval.cli.main import app
+from rgbd_eval.io.reader import open_recording
+
+runner = CliRunner()
+
+
+def test_out_suffix_chooses_the_container_and_set_changes_the_scenario(tmp_path: Path) -> None:
+    out = tmp_path / "raw.bag"
+    args = ["synth", "demo", "-o", str(out), "--frames", "2", "--set", "recording.rgb_format=raw"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    rec = open_recording(out)
+    assert rec.info.container == "ros1"
+    assert rec.info.selected.rgb == "/camera/rgb/image_color"  # raw, not .../compressed
+    assert len(rec) == 2 and (tmp_path / "raw.gt.csv").exists()
+
+
+def test_bad_overrides_and_contradictions_exit_4(tmp_path: Path) -> None:
+    unknown = runner.invoke(
+        app, ["synth", "demo", "-o", str(tmp_path / "a.mcap"), "--set", "x.y=1"]
+    )
+    assert unknown.exit_code == 4 and "x: unknown key" in unknown.output
+    clash = runner.invoke(app, ["synth", "demo", "-o", str(tmp_path / "a.mcap"), "--format", "bag"])
+    assert clash.exit_code == 4 and "needs a .bag name" in clash.output
+    assert not (tmp_path / "a.mcap").exists()
