@@ -74,3 +74,20 @@ def test_sweep_points_equal_separate_runs(tmp_path: Path) -> None:
         single = run_sequence(rec, config)
         assert single.scores is not None
         assert record.counts == single.scores.counts
+
+
+def test_cli_takes_negative_values_as_values(tmp_path: Path) -> None:
+    # The README's `sweep tracker.min_confidence -3 -2.5 ...` once failed: "No such option: -3".
+    import json
+
+    from typer.testing import CliRunner
+
+    from rgbd_eval.cli.main import app
+
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=4))
+    args = ["sweep", "tracker.min_confidence", "-3", "-2.5", "0.5", "--dataset", str(rec)]
+    args += ["--cache", str(tmp_path / "cache"), "--out", str(tmp_path / "out")]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
+    assert [r["tracker.min_confidence"] for r in records] == [-3.0, -2.5, 0.5]

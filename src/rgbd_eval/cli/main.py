@@ -21,7 +21,8 @@ app = typer.Typer(
     pretty_exceptions_enable=False,
 )
 app.command("run")(run)
-app.command("sweep")(sweep)
+# Negative sweep values (`sweep tracker.min_confidence -3 -2`) are values, not options.
+app.command("sweep", context_settings={"ignore_unknown_options": True})(sweep)
 app.command("inspect")(inspect)
 app.command("compare")(compare)
 app.command("synth")(synth)
