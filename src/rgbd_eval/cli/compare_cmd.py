@@ -10,15 +10,6 @@ from rich.table import Table
 
 from rgbd_eval.atomic import write_text
 from rgbd_eval.cli.common import console, handle_errors
-from rgbd_eval.compare import (
-    HEADER,
-    Status,
-    compare_reports,
-    load_report,
-    markdown,
-    parse_tolerances,
-    table_rows,
-)
 
 
 @handle_errors
@@ -35,6 +26,16 @@ def compare(
     all_rows: Annotated[bool, typer.Option("--all", help="show unchanged metrics too")] = False,
 ) -> None:
     """Per sequence and overall, what got better and what got worse; exit 1 on regression."""
+    from rgbd_eval.compare import (  # heavy (report -> metrics -> motmetrics/pandas): only here
+        HEADER,
+        Status,
+        compare_reports,
+        load_report,
+        markdown,
+        parse_tolerances,
+        table_rows,
+    )
+
     tolerances = parse_tolerances(tolerance or [])  # bad arguments fail before any file is read
     comparison = compare_reports(load_report(baseline), load_report(current), tolerances)
     table = Table(title=f"{baseline} -> {current}", title_justify="left")
