@@ -10,6 +10,7 @@ parsed from printed text.
 from __future__ import annotations
 
 import itertools
+import os
 import time
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -222,6 +223,13 @@ def run_sweep(
         cache_hits=hits,
         cache_misses=len(prepared) - hits,
     )
+
+
+def default_jobs() -> int:
+    """Worker processes when none are asked for: one per CPU this process may use."""
+    if hasattr(os, "sched_getaffinity"):
+        return max(1, len(os.sched_getaffinity(0)))
+    return max(1, os.cpu_count() or 1)
 
 
 def _map(func: Callable[..., Any], args: list[tuple[Any, ...]], jobs: int) -> Iterable[Any]:

@@ -18,7 +18,9 @@ def reproduce(
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/reproduce-<time>)")
     ] = None,
-    jobs: Annotated[int, typer.Option(help="worker processes")] = 1,
+    jobs: Annotated[
+        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
+    ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
 ) -> None:
     """Redo the thesis' experiments on the six synthetic scenarios (generated if absent)."""
@@ -34,6 +36,7 @@ def reproduce(
         to_json,
     )
     from rgbd_eval.sim import dataset_path, load_scenario, synthesize
+    from rgbd_eval.sweep import default_jobs
 
     recordings = {}
     for name in SCENARIOS:
@@ -44,7 +47,10 @@ def reproduce(
         recordings[name] = path
     out_dir = out or Path("runs") / f"reproduce-{time.strftime('%Y%m%d-%H%M%S')}"
     res = reproduce_basso2012(
-        recordings, jobs=jobs, cache=cache, progress=lambda m: err_console.print(m)
+        recordings,
+        jobs=jobs if jobs is not None else default_jobs(),
+        cache=cache,
+        progress=lambda m: err_console.print(m),
     )
     text = render_markdown(res, paper_values())
     write_text(out_dir / "reproduce.md", text)

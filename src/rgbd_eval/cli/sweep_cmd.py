@@ -82,7 +82,9 @@ def sweep(
         list[str] | None, typer.Option("--set", help="fixed KEY=VALUE override")
     ] = None,
     gating: Annotated[str | None, typer.Option(help="'iou' or 'metric'")] = None,
-    jobs: Annotated[int, typer.Option(help="worker processes")] = 1,
+    jobs: Annotated[
+        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
+    ] = None,
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
@@ -94,7 +96,14 @@ def sweep(
     from rgbd_eval.config import load_config
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
-    from rgbd_eval.sweep import SweepParam, expand_grid, parse_param, point_configs, run_sweep
+    from rgbd_eval.sweep import (
+        SweepParam,
+        default_jobs,
+        expand_grid,
+        parse_param,
+        point_configs,
+        run_sweep,
+    )
 
     specs: list[SweepParam] = [parse_param(p) for p in params or []]
     names = list(dataset or [])
@@ -128,6 +137,7 @@ def sweep(
     configs = point_configs(base, parse_overrides(fixed), grid)
     recordings = [datasets.resolve(n) for n in (names or ["demo"])]
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
+    jobs = jobs if jobs is not None else default_jobs()
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
     start = time.perf_counter()
     result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
