@@ -112,6 +112,7 @@ class Basso2012Tracker:
         self._next_id = 1
         # this frame's integral histograms, one row per detection (see _integrals)
         self._cums: Array | None = None
+        self._Q_dt, self._Q = 0.0, _EMPTY  # process noise of the last time step
 
     # ------------------------------------------------------------------ public
 
@@ -165,7 +166,9 @@ class Basso2012Tracker:
         return list(detections)
 
     def _predict(self, dt: float) -> None:
-        Q = process_noise(dt, self._cfg.acceleration_variance)
+        if dt != self._Q_dt:  # the frame period rarely changes: reuse Q
+            self._Q_dt, self._Q = dt, process_noise(dt, self._cfg.acceleration_variance)
+        Q = self._Q
         self._x, self._P = ukf.predict(
             self._x, self._P, lambda X: apply_transition(X, dt), Q, _SIGMA
         )
