@@ -110,6 +110,9 @@ class Basso2012Tracker:
         self._prediction: tuple[list[int], Array, Array, Array] = ([], _EMPTY, _EMPTY, _EMPTY)
         self._last_ns: int | None = None
         self._next_id = 1
+        # this frame's integral histograms, one row per detection (see _integrals)
+        self._cums: Array | None = None
+        self._Q_dt, self._Q = 0.0, _EMPTY  # process noise of the last time step
 
     # ------------------------------------------------------------------ public
 
@@ -118,6 +121,7 @@ class Basso2012Tracker:
         if self._last_ns is not None and stamp_ns <= self._last_ns:
             raise ValueError(f"stamp_ns={stamp_ns} must increase (previous frame: {self._last_ns})")
         dets = self._select(detections)
+        self._cums = None
         dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
         self._last_ns = stamp_ns
         z = np.array([d.ground_xy for d in dets], dtype=np.float64).reshape(-1, 2)
@@ -162,7 +166,9 @@ class Basso2012Tracker:
         return list(detections)
 
     def _predict(self, dt: float) -> None:
-        Q = process_noise(dt, self._cfg.acceleration_variance)
+        if dt != self._Q_dt:  # the frame period rarely changes: reuse Q
+            self._Q_dt, self._Q = dt, process_noise(dt, self._cfg.acceleration_variance)
+        Q = self._Q
         self._x, self._P = ukf.predict(
             self._x, self._P, lambda X: apply_transition(X, dt), Q, _SIGMA
         )
@@ -192,7 +198,7 @@ class Basso2012Tracker:
         seen = [j for j in free if dets[j].appearance is not None]
         if not candidates or not seen:
             return free
-        cums = self._integrals([dets[j] for j in seen])
+        cums = self._integrals(dets, seen)
         scores = np.stack([_classifier(t).predict_integrals(cums) for t in candidates])
         for i, j in score_assign(scores, self._cfg.min_prediction):
             candidates[i].detection = seen[j]
@@ -291,7 +297,7 @@ class Basso2012Tracker:
         ]
         if not lost:
             return
-        cums = self._integrals([dets[_det(self._tracks[i])] for i in young])
+        cums = self._integrals(dets, [_det(self._tracks[i]) for i in young])
         scores = np.stack([_classifier(self._tracks[i]).predict_integrals(cums) for i in lost])
         drop: list[int] = []
         for a, b in score_assign(scores, self._cfg.min_prediction):
@@ -315,7 +321,7 @@ class Basso2012Tracker:
         ]
         if not usable:
             return
-        cums = self._integrals([dets[_det(t)] for t in usable])
+        cums = self._integrals(dets, [_det(t) for t in usable])
         for a, t in enumerate(usable):
             classifier = _classifier(t)
             classifier.learn(cums[a], True)
@@ -323,10 +329,18 @@ class Basso2012Tracker:
                 if b != a:
                     classifier.learn(cums[b], False)
 
-    def _integrals(self, dets: list[Detection]) -> Array:
-        """Integral colour histograms of detections, shared by every track's classifier."""
-        hists = np.asarray(np.stack([_appearance(d) for d in dets]), dtype=np.float64)
-        return np.stack([integral_histograms(h, self._bins) for h in hists])
+    def _integrals(self, dets: list[Detection], rows: list[int]) -> Array:
+        """Integral colour histograms of ``dets[rows]``, shared by every track's classifier.
+
+        Computed at the first request of a frame for all its detections with an
+        appearance, in one batched call (rows without appearance stay zero).
+        """
+        if self._cums is None:
+            seen = [j for j, d in enumerate(dets) if d.appearance is not None]
+            hists = np.zeros((len(dets), self._bins**3))
+            hists[seen] = np.stack([_appearance(dets[j]) for j in seen])
+            self._cums = integral_histograms(hists, self._bins)
+        return self._cums[rows]
 
     def _manage(self, stamp_ns: int) -> None:
         """Discard unvalidated tracks past ``frames_before_fake``; drop forgotten ones (6.4.4)."""

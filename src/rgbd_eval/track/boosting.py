@@ -124,6 +124,15 @@ def _recursion(
     return lams, errors
 
 
+def _add_outer(W: Array, lams: list[float], miss: Array) -> Array:
+    """``W + outer(lams, miss)`` for 0/1 ``miss``, by BLAS ``dger`` on the transpose.
+
+    Each product ``lam * miss`` is exact, so the fused or plain addition rounds the same
+    as numpy's ``W + lams[:, None] * miss``; ``dger`` avoids the temporary product.
+    """
+    return np.asarray(blas.dger(1.0, miss, np.asarray(lams), a=W.T).T, dtype=np.float64)
+
+
 class OnlineBoostingClassifier:
     """An on-line boosted classifier of flattened ``bins**3`` colour histograms.
 
@@ -213,7 +222,13 @@ class OnlineBoostingClassifier:
         The integral of a histogram does not depend on the classifier: compute it once
         when several classifiers of the same ``bins`` look at the same histogram.
         """
-        return np.array([self._confidence(row) for row in integrals])
+        sel = self._selected
+        # (D, N, 8) @ (8,) runs one matrix-vector product per row: the same sums as one by one
+        f = integrals.take(self._corners[sel], axis=1) @ CORNER_SIGNS
+        says = np.where(self._hypotheses(f, sel), 1.0, -1.0)
+        votes = self._votes()
+        # one dot product per row: a (D, N) @ (N,) product may sum in another order
+        return np.array([row @ votes for row in says], dtype=np.float64)
 
     def update(self, histogram: Histograms, positive: bool) -> None:
         """Learn one labelled sample (importance 1)."""
@@ -281,13 +296,10 @@ class OnlineBoostingClassifier:
         """
         W = self._wrong
         miss = (~correct).astype(np.float64)
-        is_correct = correct.tolist()
         guess = self._selected
         totals = self._total.tolist()
-        lams, errors = _recursion(
-            W[self._rows, guess].tolist(), [is_correct[m] for m in guess.tolist()], totals
-        )
-        new_wrong = W + np.multiply.outer(np.asarray(lams), miss)
+        lams, errors = _recursion(W[self._rows, guess].tolist(), correct[guess].tolist(), totals)
+        new_wrong = _add_outer(W, lams, miss)
         masked = new_wrong.copy()
         masked.ravel()[self._taken_base + guess[self._taken_by]] = np.inf
         best = masked.argmin(axis=1)
@@ -298,6 +310,7 @@ class OnlineBoostingClassifier:
         # selectors before p took their guess; selector p takes its masked argmin
         p = int(mismatched[0])
         chosen = [*guess[:p].tolist(), int(best[p])]
+        is_correct = correct.tolist()
         lam = lams[p]
         e = float(new_wrong[p, chosen[p]]) / (totals[p] + lam)
         errors[p] = e
@@ -327,19 +340,18 @@ class OnlineBoostingClassifier:
             # taken by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact.
             work = self._wrong[start:].copy()
             work[:, chosen] = np.inf
-            rows = list(work)
             total = self._total.tolist()
-            for n in range(start, N):  # each step vectorised over the pool
-                row = blas.daxpy(miss, rows[n - start], a=lam)  # in place: row += lam * miss
+            daxpy = blas.daxpy
+            for j, row in enumerate(work, start + 1):  # row of selector j - 1, over the pool
+                row = daxpy(miss, row, a=lam)  # in place: row += lam * miss
                 m = int(row.argmin())
-                e = float(row[m]) / (total[n] + lam)
-                work[n - start + 1 :, m] = np.inf
+                e = row.item(m) / (total[j - 1] + lam)
+                work[j - start :, m] = np.inf
                 chosen.append(m)
                 errors.append(e)
                 lams.append(lam)
                 lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)
-            tail = np.asarray(lams[start:])
-            new_wrong[start:] = self._wrong[start:] + np.multiply.outer(tail, miss)
+            new_wrong[start:] = _add_outer(self._wrong[start:], lams[start:], miss)
         self._finish(new_wrong, np.asarray(lams), errors, np.asarray(chosen, dtype=np.int64))
 
     def _finish(self, wrong: Array, lams: Array, errors: list[float], chosen: IntArray) -> None:

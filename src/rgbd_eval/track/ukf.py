@@ -60,10 +60,9 @@ def sigma_points(x: Array, P: Array, w: SigmaWeights) -> Array:
 
 def unscented_transform(Y: Array, w: SigmaWeights) -> tuple[Array, Array]:
     """Mean ``(..., m)`` and covariance ``(..., m, m)`` of transformed sigma points ``Y``."""
-    y = np.einsum("k,...km->...m", w.Wm, Y)
+    y = w.Wm @ Y
     dY = Y - y[..., None, :]
-    Pyy = np.einsum("k,...ki,...kj->...ij", w.Wc, dY, dY)
-    return y, Pyy
+    return y, _weighted_outer(dY, dY, w.Wc)
 
 
 def predict(
@@ -84,8 +83,7 @@ def measurement_prediction(
     z_hat, Pzz = unscented_transform(Z, w)
     dX = X - x[..., None, :]
     dZ = Z - z_hat[..., None, :]
-    Pxz = np.einsum("k,...ki,...kj->...ij", w.Wc, dX, dZ)
-    return z_hat, Pzz, Pxz
+    return z_hat, Pzz, _weighted_outer(dX, dZ, w.Wc)
 
 
 def update(
@@ -107,6 +105,11 @@ def correct(
     x_post = x + np.einsum("...ij,...j->...i", K, y)
     P_post = P - K @ S @ np.swapaxes(K, -1, -2)
     return x_post, _symmetric(P_post)
+
+
+def _weighted_outer(dA: Array, dB: Array, weights: Array) -> Array:
+    """``sum_k weights[k] dA[..., k, :]^T dB[..., k, :]`` as one (batched) matrix product."""
+    return np.asarray((np.swapaxes(dA, -1, -2) * weights) @ dB, dtype=np.float64)
 
 
 def _symmetric(P: Array) -> Array:
