@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from rgbd_eval.config import Gating, RunConfig
@@ -102,6 +102,42 @@ def track_sequence(
     )
 
 
+def detect_and_track(
+    recording: Recording, config: RunConfig, progress: Progress | None = None
+) -> tuple[SequenceDetections, tuple[tuple[TrackOutput, ...], ...]]:
+    """Detect and track frame by frame; the detections kept lose their appearance descriptors.
+
+    The results equal :func:`detect_sequence` then :func:`track_sequence` (detector
+    and tracker are independent), but the descriptors (2 KB per detection for
+    basso2012's colour histogram) are dropped once the tracker has seen them, so
+    memory grows only by the small per-frame records (stamps, boxes, tracks).
+    """
+    detector = create_detector(config.method, config)
+    tracker = create_tracker(config.method, config)
+    stamps: list[int] = []
+    per_frame: list[tuple[Detection, ...]] = []
+    tracks: list[tuple[TrackOutput, ...]] = []
+    read_s = detect_s = track_s = 0.0
+    total = len(recording)
+    start = time.perf_counter()
+    for frame in recording.frames():
+        t0 = time.perf_counter()
+        dets = tuple(detector.detect(frame))
+        t1 = time.perf_counter()
+        tracks.append(tuple(tracker.update(frame.stamp_ns, dets)))
+        t2 = time.perf_counter()
+        per_frame.append(tuple(replace(d, appearance=None) for d in dets))
+        stamps.append(frame.stamp_ns)
+        read_s += t0 - start
+        detect_s += t1 - t0
+        track_s += t2 - t1
+        start = time.perf_counter()
+        if progress is not None:
+            progress(len(per_frame), total)
+    seconds = {"read": read_s, "detect": detect_s, "track": track_s}
+    return SequenceDetections(tuple(stamps), tuple(per_frame), seconds), tuple(tracks)
+
+
 def match_ground_truth(
     gt: GroundTruth, stamps_ns: Sequence[int], config: RunConfig
 ) -> GroundTruthMatch:
@@ -156,10 +192,7 @@ def run_sequence(
     recording = open_recording(path, config.io)
     index_s = time.perf_counter() - start
     gt = find_ground_truth(path, recording, gt_path)
-    detections = detect_sequence(recording, config, progress)
-    start = time.perf_counter()
-    tracks = track_sequence(detections, config)
-    track_s = time.perf_counter() - start
+    detections, tracks = detect_and_track(recording, config, progress)
     matched = scores = None
     score_s = 0.0
     if gt is not None:
@@ -167,7 +200,7 @@ def run_sequence(
         matched = match_ground_truth(gt, detections.stamps_ns, config)
         scores = score_sequence(matched, tracks, config)
         score_s = time.perf_counter() - start
-    seconds = {"index": index_s, **detections.seconds, "track": track_s, "score": score_s}
+    seconds = {"index": index_s, **detections.seconds, "score": score_s}
     return SequenceResult(
         name=sequence_name(path),
         path=str(path),
