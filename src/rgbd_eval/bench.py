@@ -81,7 +81,8 @@ class BenchResult:
     raw_reader: str
     #: Milliseconds per frame of a fresh tracker fed the cached detections (median).
     track_alone_ms: float
-    #: Peak resident set size of this process so far (MiB).
+    #: Peak resident set size of this process so far (MiB); it includes the detections
+    #: held for the tracking-alone replay (`rgbd-eval run` keeps them without descriptors).
     peak_rss_mib: float
     openblas_threads: str | None
     #: CPUs the process was allowed to run on (None: not known on this platform).
