@@ -21,16 +21,20 @@ Oza and Russell's on-line boosting (ref. [20]):
 - The strong classifier is ``H(x) = sum_n alpha_n h_n(x)`` (its confidence is
   compared against ``min_prediction``, Table 6.1).
 
-Speed: the importance recursion over the selectors is sequential, but the choices
-rarely change from one sample to the next. An update guesses the previous choices,
-runs the scalar recursion along them in plain Python floats, and checks all
-selectors with one masked argmin over the pool; only from the first wrong guess on
-(mostly among the last, weakest selectors) does it fall back to the step-by-step
-loop. Every weight is computed by the same floating-point operations either way,
-so the results are those of the plain loop, bit for bit
+Speed: the importance recursion over the selectors is sequential, one selector
+after the other over the whole pool, so numpy can only vectorise each step and
+pays its call overhead ``selectors`` times per sample. The per-weight part of an
+update (running means, the weak hypotheses' verdicts, the selector recursion with
+its weight and importance updates) is one loop compiled with numba
+(:func:`_learn_kernel`, no ``fastmath``): every weight is computed by the same
+floating-point operations in the same order as in the plain sequential loop, so
+the results are those of the plain loop, bit for bit
 (``tests/track/test_boosting_speed_equivalence.py`` keeps the plain implementation
-as the reference). The integral histogram of a sample does not depend on the
-classifier: :meth:`OnlineBoostingClassifier.learn` and
+as the reference). What numpy computes with BLAS or its own reductions (the
+features, the exchange's mean errors, the votes' logarithms) and the random
+draws stay in numpy, so their rounding and the random streams are unchanged. The
+integral histogram of a sample does not depend on the classifier:
+:meth:`OnlineBoostingClassifier.learn` and
 :meth:`OnlineBoostingClassifier.predict_integrals` take it precomputed, so a
 tracker computes it once per detection for all its classifiers.
 """
@@ -38,11 +42,12 @@ tracker computes it once per detection for all its classifiers.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import blas
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -105,32 +110,79 @@ def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[n
     return out.reshape(*lead, (bins + 1) ** 3)
 
 
-def _recursion(
-    values: list[float], guess_correct: list[bool], totals: list[float]
-) -> tuple[list[float], list[float]]:
-    """Oza's importance along guessed choices: each selector's lambda and weighted error.
+def _select(
+    miss: NDArray[np.bool_], wrong: Array, total: Array, selected: IntArray, errors: Array
+) -> None:
+    """Selectors in turn, in place: weigh the pool, take the best free hypothesis, pass lambda on.
 
-    ``values`` are the chosen hypotheses' wrong weights before the sample,
-    ``guess_correct`` whether they are right on it, ``totals`` the selectors' totals.
+    ``miss`` says which weak hypotheses are wrong on the sample. Selector ``n`` adds
+    its importance ``lam`` to the wrong weights ``wrong[n]`` of the missing ones and
+    to its total ``total[n]``, takes the first hypothesis with the lowest wrong weight
+    among those no earlier selector took, stores it in ``selected[n]`` and its error
+    in ``errors[n]``, and passes on Oza's importance. ``lam * miss`` is ``lam`` or
+    ``0.0``, so adding ``lam`` only where ``miss`` gives the plain loop's weights.
     """
+    N, M = wrong.shape
+    taken = np.zeros(M, dtype=np.bool_)
     lam = 1.0
-    lams: list[float] = []
-    errors: list[float] = []
-    for w, ok, total in zip(values, guess_correct, totals, strict=True):
-        e = (w if ok else w + lam) / (total + lam)
-        lams.append(lam)
-        errors.append(e)
-        lam = lam / (2.0 * (1.0 - e)) if ok else lam / (2.0 * e)
-    return lams, errors
+    for n in range(N):
+        m = -1
+        best = np.inf
+        for j in range(M):
+            w = wrong[n, j]
+            if miss[j]:
+                w += lam
+                wrong[n, j] = w
+            if not taken[j] and (m < 0 or w < best):  # numpy argmin: the first minimum
+                m, best = j, w
+        e = best / (total[n] + lam)
+        total[n] += lam
+        taken[m] = True
+        selected[n] = m
+        errors[n] = e
+        lam = lam / (2.0 * e) if miss[m] else lam / (2.0 * (1.0 - e))
 
 
-def _add_outer(W: Array, lams: list[float], miss: Array) -> Array:
-    """``W + outer(lams, miss)`` for 0/1 ``miss``, by BLAS ``dger`` on the transpose.
+def _learn_step(
+    f: Array,
+    positive: bool,
+    rate: float,
+    mean: Array,
+    count: Array,
+    wrong: Array,
+    total: Array,
+    selected: IntArray,
+    errors: Array,
+) -> None:
+    """One sample of features ``f`` in place: running means, verdicts, then :func:`_select`.
 
-    Each product ``lam * miss`` is exact, so the fused or plain addition rounds the same
-    as numpy's ``W + lams[:, None] * miss``; ``dger`` avoids the temporary product.
+    The gain of the running mean is ``max(1 / (count + 1), rate)``; a weak hypothesis
+    says "positive" on the positive side of the midpoint of its two means.
     """
-    return np.asarray(blas.dger(1.0, miss, np.asarray(lams), a=W.T).T, dtype=np.float64)
+    M = f.shape[0]
+    k = 1 if positive else 0
+    miss = np.empty(M, dtype=np.bool_)
+    for j in range(M):
+        gain = 1.0 / (count[k, j] + 1.0)
+        if gain < rate:
+            gain = rate
+        mean[k, j] += gain * (f[j] - mean[k, j])
+        count[k, j] += 1.0
+        neg, pos = mean[0, j], mean[1, j]
+        threshold = 0.5 * (neg + pos)
+        says_positive = f[j] > threshold if pos >= neg else f[j] < threshold
+        miss[j] = says_positive != positive
+    _select_kernel(miss, wrong, total, selected, errors)
+
+
+#: :func:`_select` and :func:`_learn_step` compiled (on first use; cached on disk).
+#: No ``fastmath``: the operations are rounded one by one, as in numpy.
+_select_kernel: Callable[[NDArray[np.bool_], Array, Array, IntArray, Array], None] = numba.njit(
+    cache=True
+)(_select)
+_learn_kernel: Callable[[Array, bool, float, Array, Array, Array, Array, IntArray, Array], None] = (
+    numba.njit(cache=True)(_learn_step)
+)
 
 
 class OnlineBoostingClassifier:
@@ -176,11 +228,7 @@ class OnlineBoostingClassifier:
         self._total = np.full(N, 2.0 * _INITIAL_WEIGHT)
         self._selected = np.zeros(N, dtype=np.int64)
         self._alpha: Array | None = np.zeros(N)  # None: derive from _errors when needed
-        self._errors: list[float] = []
-        # _boost's check: flat indices of (selector n, column of the choice of selector k < n)
-        self._rows = np.arange(N)
-        taken_rows, self._taken_by = np.tril_indices(N, -1)
-        self._taken_base = taken_rows * M
+        self._errors = np.zeros(N)  # the selectors' errors on the last sample
         self.positives = 0
         self.negatives = 0
 
@@ -240,12 +288,18 @@ class OnlineBoostingClassifier:
     def learn(self, integral: Array, positive: bool) -> None:
         """:meth:`update` given the sample's :func:`integral_histograms` ``((bins+1)**3,)``."""
         f = np.asarray(integral.take(self._corners) @ CORNER_SIGNS, dtype=np.float64)
-        k = 1 if positive else 0
-        gain = np.maximum(1.0 / (self._count[k] + 1.0), self._rate)
-        self._mean[k] += gain * (f - self._mean[k])
-        self._count[k] += 1.0
-        correct = self._hypotheses(f, None) == positive
-        self._boost(correct)
+        _learn_kernel(
+            f,
+            bool(positive),
+            self._rate,
+            self._mean,
+            self._count,
+            self._wrong,
+            self._total,
+            self._selected,
+            self._errors,
+        )
+        self._alpha = None  # only predictions need the votes: derived on demand
         self._exchange_worst()
         if positive:
             self.positives += 1
@@ -274,98 +328,17 @@ class OnlineBoostingClassifier:
             )
         return h
 
-    def _hypotheses(self, f: Array, columns: IntArray | None) -> NDArray[np.bool_]:
-        """Which weak hypotheses say "positive" for features ``f`` (of ``columns``)."""
-        mean = self._mean if columns is None else self._mean[:, columns]
+    def _hypotheses(self, f: Array, columns: IntArray) -> NDArray[np.bool_]:
+        """Which weak hypotheses ``columns`` say "positive" for their features ``f``."""
+        mean = self._mean[:, columns]
         neg, pos = mean[0], mean[1]
         threshold = 0.5 * (neg + pos)
         return np.asarray(np.where(pos >= neg, f > threshold, f < threshold), dtype=bool)
 
-    def _boost(self, correct: NDArray[np.bool_]) -> None:
-        """Selectors in turn: weigh the pool, take the best free hypothesis, pass lambda on.
-
-        The choices are those of the plain sequential recursion (:meth:`_boost_from`),
-        found faster: guess that every selector takes the same hypothesis as on the
-        previous sample, run the scalar importance recursion along that guess, and check
-        every selector at once (one masked argmin over the pool). If each selector's
-        argmin is its guess, the guess is the recursion's result (by induction over the
-        selectors). Otherwise the selectors before the first mismatch are right, the
-        mismatched one is right with its argmin, and the sequential loop finishes from
-        there. Every weight is computed by the same floating-point operations as in the
-        sequential loop, so the results are the same bit for bit.
-        """
-        W = self._wrong
-        miss = (~correct).astype(np.float64)
-        guess = self._selected
-        totals = self._total.tolist()
-        lams, errors = _recursion(W[self._rows, guess].tolist(), correct[guess].tolist(), totals)
-        new_wrong = _add_outer(W, lams, miss)
-        masked = new_wrong.copy()
-        masked.ravel()[self._taken_base + guess[self._taken_by]] = np.inf
-        best = masked.argmin(axis=1)
-        mismatched = np.flatnonzero(best != guess)
-        if len(mismatched) == 0:
-            self._finish(new_wrong, np.asarray(lams), errors, guess.copy())
-            return
-        # selectors before p took their guess; selector p takes its masked argmin
-        p = int(mismatched[0])
-        chosen = [*guess[:p].tolist(), int(best[p])]
-        is_correct = correct.tolist()
-        lam = lams[p]
-        e = float(new_wrong[p, chosen[p]]) / (totals[p] + lam)
-        errors[p] = e
-        lam_next = lam / (2.0 * (1.0 - e)) if is_correct[chosen[p]] else lam / (2.0 * e)
-        del lams[p + 1 :], errors[p + 1 :]
-        self._boost_from(new_wrong, chosen, lams, errors, lam_next, miss, is_correct)
-
-    def _boost_from(
-        self,
-        new_wrong: Array,
-        chosen: list[int],
-        lams: list[float],
-        errors: list[float],
-        lam: float,
-        miss: Array,
-        is_correct: list[bool],
-    ) -> None:
-        """The sequential recursion from selector ``start = len(chosen)`` on, lambda ``lam``.
-
-        The earlier selectors' choices, lambdas, errors and rows of ``new_wrong`` are
-        given; the rest are filled in.
-        """
-        N = self._wrong.shape[0]
-        start = len(chosen)
-        if start < N:
-            # scratch copy: row n becomes the wrong weights after this sample; hypotheses
-            # taken by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact.
-            work = self._wrong[start:].copy()
-            work[:, chosen] = np.inf
-            total = self._total.tolist()
-            daxpy = blas.daxpy
-            for j, row in enumerate(work, start + 1):  # row of selector j - 1, over the pool
-                row = daxpy(miss, row, a=lam)  # in place: row += lam * miss
-                m = int(row.argmin())
-                e = row.item(m) / (total[j - 1] + lam)
-                work[j - start :, m] = np.inf
-                chosen.append(m)
-                errors.append(e)
-                lams.append(lam)
-                lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)
-            new_wrong[start:] = _add_outer(self._wrong[start:], lams[start:], miss)
-        self._finish(new_wrong, np.asarray(lams), errors, np.asarray(chosen, dtype=np.int64))
-
-    def _finish(self, wrong: Array, lams: Array, errors: list[float], chosen: IntArray) -> None:
-        """Store a sample's new weights, choices and votes."""
-        self._wrong = wrong
-        self._total += lams
-        self._errors = errors
-        self._selected = chosen
-        self._alpha = None  # only predictions need the votes: derived on demand
-
     def _votes(self) -> Array:
         """``alpha_n = 1/2 ln((1 - e_n)/e_n)``, 0 when ``e_n >= 1/2``, of the last sample's errors."""
         if self._alpha is None:
-            err = np.asarray(self._errors)
+            err = self._errors
             self._alpha = np.where(err < 0.5, 0.5 * np.log((1.0 - err) / err), 0.0)
         return self._alpha
 
