@@ -45,6 +45,15 @@ Histograms = NDArray[np.floating[Any]]
 COLOURS = [(200.0, 40.0, 40.0), (40.0, 40.0, 200.0), (40.0, 200.0, 40.0), (120.0, 120.0, 60.0)]
 
 
+def reference_integrals(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
+    """:func:`~rgbd_eval.track.boosting.integral_histograms` by numpy's cumulative sums."""
+    lead = histograms.shape[:-1]
+    cube = histograms.reshape(*lead, bins, bins, bins)
+    out = np.zeros((*lead, bins + 1, bins + 1, bins + 1))
+    out[..., 1:, 1:, 1:] = cube.cumsum(-1).cumsum(-2).cumsum(-3)
+    return out.reshape(*lead, (bins + 1) ** 3)
+
+
 class ReferenceBoostingClassifier:
     """The sequential implementation, as it was before the speed-up (kept verbatim).
 
@@ -151,7 +160,7 @@ class ReferenceBoostingClassifier:
 
     def _box_sums(self, h: Array, corners: IntArray) -> Array:
         """Mass of one histogram ``(bins**3,)`` in the boxes given by their corners."""
-        cum = integral_histograms(h, self.bins)
+        cum = reference_integrals(h, self.bins)
         return np.asarray(cum.take(corners) @ CORNER_SIGNS, dtype=np.float64)
 
     def _check(self, histograms: Histograms) -> Array:
@@ -310,6 +319,25 @@ def test_compiled_kernel_equals_its_python_source(
     for a, b in zip(state, copy, strict=True):
         assert np.array_equal(a, b)
     assert sorted(set(state[4].tolist())) == sorted(state[4].tolist())  # distinct choices
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(1, 9),
+    st.sampled_from([(), (1,), (5,), (2, 3)]),
+    st.sampled_from([np.float32, np.float64]),
+)
+def test_integral_histograms_equal_numpy_cumulative_sums(
+    seed: int, bins: int, lead: tuple[int, ...], dtype: type[np.floating[Any]]
+) -> None:
+    rng = np.random.default_rng(seed)
+    h = rng.random((*lead, bins**3)).astype(dtype).astype(np.float64)
+    h[rng.random(h.shape) < 0.3] = 0.0  # empty bins, as in real histograms
+    got, want = integral_histograms(h, bins), reference_integrals(h, bins)
+    assert got.shape == want.shape == (*lead, (bins + 1) ** 3)
+    assert np.array_equal(got, want)
+    assert np.array_equal(np.signbit(got), np.signbit(want))
 
 
 def test_predict_integrals_equals_predict() -> None:

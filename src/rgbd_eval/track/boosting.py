@@ -102,12 +102,46 @@ def _one_box_corners(box: list[list[int]], bins: int) -> list[int]:
 
 
 def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
-    """Zero-padded cumulative sums ``(..., (bins+1)**3)`` of flattened ``bins**3`` histograms."""
+    """Zero-padded cumulative sums ``(..., (bins+1)**3)`` of flattened ``bins**3`` histograms.
+
+    The sums of numpy's ``cube.cumsum(-1).cumsum(-2).cumsum(-3)``, in the same order
+    (compiled: :func:`_integrate`).
+    """
     lead = histograms.shape[:-1]
-    cube = histograms.reshape(*lead, bins, bins, bins)
-    out = np.zeros((*lead, bins + 1, bins + 1, bins + 1))
-    out[..., 1:, 1:, 1:] = cube.cumsum(-1).cumsum(-2).cumsum(-3)
+    flat = np.ascontiguousarray(histograms, dtype=np.float64).reshape(-1, bins**3)
+    out = np.zeros((len(flat), (bins + 1) ** 3))
+    _integrate_kernel(flat, bins, out)
     return out.reshape(*lead, (bins + 1) ** 3)
+
+
+def _integrate(histograms: Array, bins: int, out: Array) -> None:
+    """Cumulative sums of ``histograms`` ``(D, bins**3)`` into the zeroed ``out[:, 1:, 1:, 1:]``.
+
+    ``out`` is ``(D, (bins+1)**3)``, a zero layer first on each axis. The sums run
+    along b, then g, then r, each from the second entry on: ``s[i] = s[i-1] + x[i]``,
+    the additions of numpy's cumulative sums.
+    """
+    s = bins + 1
+    for d in range(histograms.shape[0]):
+        h, o = histograms[d], out[d]
+        for r in range(bins):
+            for g in range(bins):
+                src, dst = (r * bins + g) * bins, ((r + 1) * s + g + 1) * s + 1
+                acc = h[src]
+                o[dst] = acc
+                for b in range(1, bins):
+                    acc = acc + h[src + b]
+                    o[dst + b] = acc
+        for r in range(1, s):  # along g
+            for g in range(2, s):
+                for b in range(1, s):
+                    i = (r * s + g) * s + b
+                    o[i] = o[i - s] + o[i]
+        for r in range(2, s):  # along r
+            for g in range(1, s):
+                for b in range(1, s):
+                    i = (r * s + g) * s + b
+                    o[i] = o[i - s * s] + o[i]
 
 
 def _select(
@@ -175,8 +209,9 @@ def _learn_step(
     _select_kernel(miss, wrong, total, selected, errors)
 
 
-#: :func:`_select` and :func:`_learn_step` compiled (on first use; cached on disk).
-#: No ``fastmath``: the operations are rounded one by one, as in numpy.
+#: :func:`_integrate`, :func:`_select` and :func:`_learn_step` compiled (on first use;
+#: cached on disk). No ``fastmath``: the operations are rounded one by one, as in numpy.
+_integrate_kernel: Callable[[Array, int, Array], None] = numba.njit(cache=True)(_integrate)
 _select_kernel: Callable[[NDArray[np.bool_], Array, Array, IntArray, Array], None] = numba.njit(
     cache=True
 )(_select)
