@@ -30,6 +30,7 @@ from rgbd_eval.track.boosting import (
     _INITIAL_WEIGHT,
     CORNER_SIGNS,
     OnlineBoostingClassifier,
+    _exchange_kernel,
     _learn_kernel,
     box_corners,
     integral_histograms,
@@ -309,6 +310,7 @@ def test_compiled_kernel_equals_its_python_source(
         rng.uniform(8.0, 12.0, N),  # total
         np.zeros(N, dtype=np.int64),  # selected
         np.zeros(N),  # errors
+        np.zeros(N),  # error scale
     ]
     f = rng.integers(0, 4, M) / 4.0
     copy = [a.copy() for a in state]
@@ -318,7 +320,24 @@ def test_compiled_kernel_equals_its_python_source(
         boosting._learn_step(f, positive, 0.05, *copy)
     for a, b in zip(state, copy, strict=True):
         assert np.array_equal(a, b)
-    assert sorted(set(state[4].tolist())) == sorted(state[4].tolist())  # distinct choices
+    selected = state[4]
+    assert sorted(set(selected.tolist())) == sorted(selected.tolist())  # distinct choices
+    # the exchange: ties in the mean error, and no free hypothesis when extra == 0
+    mean_error = rng.integers(0, 3, M) / 2.0
+    box = random_boxes(rng, 1, 4)[0]
+    boxes = random_boxes(rng, M, 4)
+    pool = [mean_error, boxes, box_corners(boxes, 4), state[0], state[1]]
+    copy = [a.copy() for a in pool]
+    m = _exchange_kernel(pool[0], selected, box, 4, *pool[1:])
+    assert m == boosting._exchange(copy[0], selected, box, 4, *copy[1:])
+    for a, b in zip(pool, copy, strict=True):
+        assert np.array_equal(a, b)
+    if extra == 0:
+        assert m == -1
+    else:
+        free = np.setdiff1d(np.arange(M), selected)
+        assert m == free[np.argmax(mean_error[free])]  # the first of the highest
+        assert np.array_equal(pool[2][m], box_corners(box[None], 4)[0])
 
 
 @settings(max_examples=40, deadline=None)

@@ -41,7 +41,6 @@ tracker computes it once per detection for all its classifiers.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from typing import Any
 
@@ -88,17 +87,6 @@ def box_corners(boxes: IntArray, bins: int) -> IntArray:
     lo, hi = boxes[:, None, :, 0], boxes[:, None, :, 1] + 1
     c = np.where(_CORNER_FACES[None] == 1, hi, lo)  # (count, 8, 3)
     return np.asarray((c[..., 0] * side + c[..., 1]) * side + c[..., 2], dtype=np.int64)
-
-
-def _one_box_corners(box: list[list[int]], bins: int) -> list[int]:
-    """:func:`box_corners` of one box ``[[r0, r1], [g0, g1], [b0, b1]]`` with Python ints."""
-    side = bins + 1
-    (r0, r1), (g0, g1), (b0, b1) = box
-    out: list[int] = []
-    for r in (r0, r1 + 1):
-        for g in (g0, g1 + 1):
-            out.extend(((r * side + g) * side + b0, (r * side + g) * side + b1 + 1))
-    return out
 
 
 def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
@@ -187,11 +175,13 @@ def _learn_step(
     total: Array,
     selected: IntArray,
     errors: Array,
+    scale: Array,
 ) -> None:
     """One sample of features ``f`` in place: running means, verdicts, then :func:`_select`.
 
     The gain of the running mean is ``max(1 / (count + 1), rate)``; a weak hypothesis
-    says "positive" on the positive side of the midpoint of its two means.
+    says "positive" on the positive side of the midpoint of its two means. ``scale``
+    gets ``1 / (N total)``, the selectors' weights in the hypotheses' mean error.
     """
     M = f.shape[0]
     k = 1 if positive else 0
@@ -207,17 +197,62 @@ def _learn_step(
         says_positive = f[j] > threshold if pos >= neg else f[j] < threshold
         miss[j] = says_positive != positive
     _select_kernel(miss, wrong, total, selected, errors)
+    N = total.shape[0]
+    for n in range(N):
+        scale[n] = 1.0 / (N * total[n])
 
 
-#: :func:`_integrate`, :func:`_select` and :func:`_learn_step` compiled (on first use;
-#: cached on disk). No ``fastmath``: the operations are rounded one by one, as in numpy.
+def _exchange(
+    mean_error: Array,
+    selected: IntArray,
+    box: IntArray,
+    bins: int,
+    boxes: IntArray,
+    corners: IntArray,
+    mean: Array,
+    count: Array,
+) -> int:
+    """Replace the unselected hypothesis of highest ``mean_error`` by ``box``; its index or -1.
+
+    The first of the highest (numpy's argmax), -1 when every hypothesis is selected.
+    The new hypothesis gets the box, its :func:`box_corners` and empty running means;
+    ``mean_error`` is scratch.
+    """
+    for n in range(selected.shape[0]):
+        mean_error[selected[n]] = -np.inf
+    m = 0
+    for j in range(1, mean_error.shape[0]):
+        if mean_error[j] > mean_error[m]:
+            m = j
+    if mean_error[m] == -np.inf:
+        return -1
+    side = bins + 1
+    k = 0
+    for r in (box[0, 0], box[0, 1] + 1):
+        for g in (box[1, 0], box[1, 1] + 1):
+            for b in (box[2, 0], box[2, 1] + 1):
+                corners[m, k] = (r * side + g) * side + b
+                k += 1
+    boxes[m] = box
+    for row in range(2):
+        mean[row, m] = 0.0
+        count[row, m] = 0.0
+    return m
+
+
+#: :func:`_integrate`, :func:`_select`, :func:`_learn_step` and :func:`_exchange` compiled
+#: (on first use; cached on disk). No ``fastmath``: the operations are rounded one by one, as
+#: in numpy.
 _integrate_kernel: Callable[[Array, int, Array], None] = numba.njit(cache=True)(_integrate)
 _select_kernel: Callable[[NDArray[np.bool_], Array, Array, IntArray, Array], None] = numba.njit(
     cache=True
 )(_select)
-_learn_kernel: Callable[[Array, bool, float, Array, Array, Array, Array, IntArray, Array], None] = (
-    numba.njit(cache=True)(_learn_step)
-)
+_learn_kernel: Callable[
+    [Array, bool, float, Array, Array, Array, Array, IntArray, Array, Array], None
+] = numba.njit(cache=True)(_learn_step)
+_exchange_kernel: Callable[
+    [Array, IntArray, IntArray, int, IntArray, IntArray, Array, Array], int
+] = numba.njit(cache=True)(_exchange)
 
 
 class OnlineBoostingClassifier:
@@ -264,6 +299,7 @@ class OnlineBoostingClassifier:
         self._selected = np.zeros(N, dtype=np.int64)
         self._alpha: Array | None = np.zeros(N)  # None: derive from _errors when needed
         self._errors = np.zeros(N)  # the selectors' errors on the last sample
+        self._error_scale = np.zeros(N)  # 1 / (N total): mean error = _error_scale @ _wrong
         self.positives = 0
         self.negatives = 0
 
@@ -333,6 +369,7 @@ class OnlineBoostingClassifier:
             self._total,
             self._selected,
             self._errors,
+            self._error_scale,
         )
         self._alpha = None  # only predictions need the votes: derived on demand
         self._exchange_worst()
@@ -378,18 +415,14 @@ class OnlineBoostingClassifier:
         return self._alpha
 
     def _exchange_worst(self) -> None:
-        mean_error = (1.0 / (len(self._total) * self._total)) @ self._wrong
-        mean_error[self._selected] = -math.inf
-        m = int(mean_error.argmax())
-        if mean_error[m] == -math.inf:
+        mean_error = self._error_scale @ self._wrong
+        box = self._spare_boxes[self._spare_next]
+        args = (self._boxes, self._corners, self._mean, self._count)
+        m = _exchange_kernel(mean_error, self._selected, box, self.bins, *args)
+        if m < 0:
             return  # every weak hypothesis is in use
-        if self._spare_next >= len(self._spare_boxes):
+        self._wrong[:, m] = self._wrong @ self._mean_weights
+        self._spare_next += 1
+        if self._spare_next == len(self._spare_boxes):  # draw the next block
             self._spare_boxes = random_boxes(self._rng, len(self._boxes), self.bins)
             self._spare_next = 0
-        box = self._spare_boxes[self._spare_next]
-        self._spare_next += 1
-        self._boxes[m] = box
-        self._corners[m] = _one_box_corners(box.tolist(), self.bins)
-        self._mean[:, m] = 0.0
-        self._count[:, m] = 0.0
-        self._wrong[:, m] = self._wrong @ self._mean_weights
