@@ -142,24 +142,39 @@ def _select(
     to its total ``total[n]``, takes the first hypothesis with the lowest wrong weight
     among those no earlier selector took, stores it in ``selected[n]`` and its error
     in ``errors[n]``, and passes on Oza's importance. ``lam * miss`` is ``lam`` or
-    ``0.0``, so adding ``lam`` only where ``miss`` gives the plain loop's weights.
+    ``0.0``, so adding ``lam`` or ``0.0`` gives the plain loop's weights.
     """
     N, M = wrong.shape
-    taken = np.zeros(M, dtype=np.bool_)
+    taken = np.zeros(M)  # inf for the hypotheses earlier selectors took
+    free = np.empty(M)  # this selector's weights, inf where taken
     lam = 1.0
     for n in range(N):
-        m = -1
-        best = np.inf
         for j in range(M):
-            w = wrong[n, j]
-            if miss[j]:
-                w += lam
-                wrong[n, j] = w
-            if not taken[j] and (m < 0 or w < best):  # numpy argmin: the first minimum
-                m, best = j, w
+            w = wrong[n, j] + (lam if miss[j] else 0.0)
+            wrong[n, j] = w
+            free[j] = w + taken[j]
+        # the minimum by four running minima (exact in any order), then numpy's argmin:
+        # the first index that holds it
+        a0 = a1 = a2 = a3 = np.inf
+        j = 0
+        while j + 4 <= M:
+            x0, x1, x2, x3 = free[j], free[j + 1], free[j + 2], free[j + 3]
+            a0 = x0 if x0 < a0 else a0
+            a1 = x1 if x1 < a1 else a1
+            a2 = x2 if x2 < a2 else a2
+            a3 = x3 if x3 < a3 else a3
+            j += 4
+        for i in range(j, M):
+            a0 = free[i] if free[i] < a0 else a0
+        a0 = a1 if a1 < a0 else a0
+        a2 = a3 if a3 < a2 else a2
+        best = a2 if a2 < a0 else a0
+        m = 0
+        while free[m] != best:
+            m += 1
         e = best / (total[n] + lam)
         total[n] += lam
-        taken[m] = True
+        taken[m] = np.inf
         selected[n] = m
         errors[n] = e
         lam = lam / (2.0 * e) if miss[m] else lam / (2.0 * (1.0 - e))
