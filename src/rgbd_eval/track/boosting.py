@@ -26,13 +26,16 @@ after the other over the whole pool, so numpy can only vectorise each step and
 pays its call overhead ``selectors`` times per sample. The per-weight part of an
 update (running means, the weak hypotheses' verdicts, the selector recursion with
 its weight and importance updates) is one loop compiled with numba
-(:func:`_learn_kernel`, no ``fastmath``): every weight is computed by the same
-floating-point operations in the same order as in the plain sequential loop, so
-the results are those of the plain loop, bit for bit
-(``tests/track/test_boosting_speed_equivalence.py`` keeps the plain implementation
-as the reference). What numpy computes with BLAS or its own reductions (the
-features, the exchange's mean errors, the votes' logarithms) and the random
-draws stay in numpy, so their rounding and the random streams are unchanged. The
+(:func:`_learn_step`); so are the exchange's choice and bookkeeping
+(:func:`_exchange`) and the integral histograms (:func:`_integrate`). They are
+compiled without ``fastmath`` and compute every value by the same floating-point
+operations in the same order as the plain numpy implementation, so the results
+are those of the plain implementation, bit for bit
+(``tests/track/test_boosting_speed_equivalence.py`` keeps it as the reference).
+What numpy computes with BLAS or its own reductions (the features, the exchange's
+mean errors and new weights, the votes' logarithms) and the random draws stay in
+numpy, so their rounding and the random streams are unchanged. The kernels compile
+on first use (about a second) and are cached on disk (``cache=True``). The
 integral histogram of a sample does not depend on the classifier:
 :meth:`OnlineBoostingClassifier.learn` and
 :meth:`OnlineBoostingClassifier.predict_integrals` take it precomputed, so a
@@ -242,13 +245,14 @@ def _exchange(
     if mean_error[m] == -np.inf:
         return -1
     side = bins + 1
-    k = 0
-    for r in (box[0, 0], box[0, 1] + 1):
-        for g in (box[1, 0], box[1, 1] + 1):
-            for b in (box[2, 0], box[2, 1] + 1):
-                corners[m, k] = (r * side + g) * side + b
-                k += 1
-    boxes[m] = box
+    for k in range(8):  # face of r, g, b: bits 2, 1, 0 of k (lower 0, upper 1)
+        r = box[0, 0] if k & 4 == 0 else box[0, 1] + 1
+        g = box[1, 0] if k & 2 == 0 else box[1, 1] + 1
+        b = box[2, 0] if k & 1 == 0 else box[2, 1] + 1
+        corners[m, k] = (r * side + g) * side + b
+    for axis in range(3):
+        boxes[m, axis, 0] = box[axis, 0]
+        boxes[m, axis, 1] = box[axis, 1]
     for row in range(2):
         mean[row, m] = 0.0
         count[row, m] = 0.0
