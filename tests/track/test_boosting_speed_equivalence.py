@@ -1,12 +1,12 @@
-"""The fast selector update gives the same results, bit for bit, as the sequential one.
+"""The compiled classifier update gives the same results, bit for bit, as the plain one.
 
 ``ReferenceBoostingClassifier`` below is the implementation of
-:class:`~rgbd_eval.track.boosting.OnlineBoostingClassifier` before the speed-up
-(issue 8), kept verbatim: its selector loop runs Oza's importance recursion one
-selector at a time. The fast one guesses the choices, checks them all at once and
-falls back to the loop from the first wrong guess; the tests drive both with the
-same samples and compare every piece of state and every prediction exactly, and
-run the basso2012 tracker with either classifier on the same streams.
+:class:`~rgbd_eval.track.boosting.OnlineBoostingClassifier` before the speed-ups
+(issue 8), kept verbatim: plain numpy, its selector loop runs Oza's importance
+recursion one selector at a time. The fast one runs the running means and the
+selector recursion in one numba-compiled loop; the tests drive both with the same
+samples and compare every piece of state and every prediction exactly, and run the
+basso2012 tracker with either classifier on the same streams.
 """
 
 from __future__ import annotations
@@ -23,12 +23,15 @@ from numpy.typing import NDArray
 from scipy.linalg import blas
 
 import rgbd_eval.track.basso2012 as basso2012
+import rgbd_eval.track.boosting as boosting
 from rgbd_eval.config import RunConfig, TrackerConfig
 from rgbd_eval.track import create_tracker
 from rgbd_eval.track.boosting import (
     _INITIAL_WEIGHT,
     CORNER_SIGNS,
     OnlineBoostingClassifier,
+    _exchange_kernel,
+    _learn_kernel,
     box_corners,
     integral_histograms,
     random_boxes,
@@ -41,6 +44,15 @@ IntArray = NDArray[np.int64]
 Histograms = NDArray[np.floating[Any]]
 
 COLOURS = [(200.0, 40.0, 40.0), (40.0, 40.0, 200.0), (40.0, 200.0, 40.0), (120.0, 120.0, 60.0)]
+
+
+def reference_integrals(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
+    """:func:`~rgbd_eval.track.boosting.integral_histograms` by numpy's cumulative sums."""
+    lead = histograms.shape[:-1]
+    cube = histograms.reshape(*lead, bins, bins, bins)
+    out = np.zeros((*lead, bins + 1, bins + 1, bins + 1))
+    out[..., 1:, 1:, 1:] = cube.cumsum(-1).cumsum(-2).cumsum(-3)
+    return out.reshape(*lead, (bins + 1) ** 3)
 
 
 class ReferenceBoostingClassifier:
@@ -149,7 +161,7 @@ class ReferenceBoostingClassifier:
 
     def _box_sums(self, h: Array, corners: IntArray) -> Array:
         """Mass of one histogram ``(bins**3,)`` in the boxes given by their corners."""
-        cum = integral_histograms(h, self.bins)
+        cum = reference_integrals(h, self.bins)
         return np.asarray(cum.take(corners) @ CORNER_SIGNS, dtype=np.float64)
 
     def _check(self, histograms: Histograms) -> Array:
@@ -267,32 +279,84 @@ def test_same_state_and_predictions_after_every_update(
         assert np.array_equal(fast.features(h), ref.features(h))
 
 
-def test_same_results_over_a_long_training_with_both_paths_taken(
-    monkeypatch: pytest.MonkeyPatch,
-) -> None:
-    calls = {"boost": 0, "fallback": 0}
-    boost, fallback = OnlineBoostingClassifier._boost, OnlineBoostingClassifier._boost_from
-
-    def counting_boost(self: OnlineBoostingClassifier, correct: NDArray[np.bool_]) -> None:
-        calls["boost"] += 1
-        boost(self, correct)
-
-    def counting_fallback(self: OnlineBoostingClassifier, *args: Any) -> None:
-        calls["fallback"] += 1
-        fallback(self, *args)
-
-    monkeypatch.setattr(OnlineBoostingClassifier, "_boost", counting_boost)
-    monkeypatch.setattr(OnlineBoostingClassifier, "_boost_from", counting_fallback)
+def test_same_results_over_a_long_training_with_changing_choices() -> None:
     fast = OnlineBoostingClassifier(8, seed=3)  # Table 6.1 sizes: 250 weak, 50 selectors
     ref = ReferenceBoostingClassifier(8, seed=3)
+    changed = 0
     for h, label in _samples(11, 400, 8, 3):
+        before = fast.selected
         fast.update(h, label)
         ref.update(h, label)
+        changed += not np.array_equal(before, fast.selected)
     _same_state(fast, ref)
     probe = np.stack([h for h, _ in _samples(12, 20, 8, 4)])
     assert np.array_equal(fast.predict(probe), ref.predict(probe))
-    # both the checked guess and the sequential fall-back were exercised
-    assert 0 < calls["fallback"] < calls["boost"] == 400
+    # the selectors' choices both stayed and changed from one sample to the next
+    assert 0 < changed < 400
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 8), st.integers(0, 8), st.booleans())
+def test_compiled_kernel_equals_its_python_source(
+    seed: int, N: int, extra: int, positive: bool
+) -> None:
+    """numba's loops round like the same loops run by Python (ties included: coarse weights)."""
+    rng = np.random.default_rng(seed)
+    M = N + extra
+    state = [
+        rng.integers(0, 4, (2, M)) / 4.0,  # mean
+        rng.integers(0, 30, (2, M)).astype(np.float64),  # count
+        rng.integers(1, 8, (N, M)) / 2.0,  # wrong
+        rng.uniform(8.0, 12.0, N),  # total
+        np.zeros(N, dtype=np.int64),  # selected
+        np.zeros(N),  # errors
+        np.zeros(N),  # error scale
+    ]
+    f = rng.integers(0, 4, M) / 4.0
+    copy = [a.copy() for a in state]
+    _learn_kernel(f, positive, 0.05, *state)
+    with pytest.MonkeyPatch.context() as patch:  # the compiled kernel is already built
+        patch.setattr(boosting, "_select_kernel", boosting._select)
+        boosting._learn_step(f, positive, 0.05, *copy)
+    for a, b in zip(state, copy, strict=True):
+        assert np.array_equal(a, b)
+    selected = state[4]
+    assert sorted(set(selected.tolist())) == sorted(selected.tolist())  # distinct choices
+    # the exchange: ties in the mean error, and no free hypothesis when extra == 0
+    mean_error = rng.integers(0, 3, M) / 2.0
+    box = random_boxes(rng, 1, 4)[0]
+    boxes = random_boxes(rng, M, 4)
+    pool = [mean_error, boxes, box_corners(boxes, 4), state[0], state[1]]
+    copy = [a.copy() for a in pool]
+    m = _exchange_kernel(pool[0], selected, box, 4, *pool[1:])
+    assert m == boosting._exchange(copy[0], selected, box, 4, *copy[1:])
+    for a, b in zip(pool, copy, strict=True):
+        assert np.array_equal(a, b)
+    if extra == 0:
+        assert m == -1
+    else:
+        free = np.setdiff1d(np.arange(M), selected)
+        assert m == free[np.argmax(mean_error[free])]  # the first of the highest
+        assert np.array_equal(pool[2][m], box_corners(box[None], 4)[0])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(1, 9),
+    st.sampled_from([(), (1,), (5,), (2, 3)]),
+    st.sampled_from([np.float32, np.float64]),
+)
+def test_integral_histograms_equal_numpy_cumulative_sums(
+    seed: int, bins: int, lead: tuple[int, ...], dtype: type[np.floating[Any]]
+) -> None:
+    rng = np.random.default_rng(seed)
+    h = rng.random((*lead, bins**3)).astype(dtype).astype(np.float64)
+    h[rng.random(h.shape) < 0.3] = 0.0  # empty bins, as in real histograms
+    got, want = integral_histograms(h, bins), reference_integrals(h, bins)
+    assert got.shape == want.shape == (*lead, (bins + 1) ** 3)
+    assert np.array_equal(got, want)
+    assert np.array_equal(np.signbit(got), np.signbit(want))
 
 
 def test_predict_integrals_equals_predict() -> None:

@@ -21,28 +21,35 @@ Oza and Russell's on-line boosting (ref. [20]):
 - The strong classifier is ``H(x) = sum_n alpha_n h_n(x)`` (its confidence is
   compared against ``min_prediction``, Table 6.1).
 
-Speed: the importance recursion over the selectors is sequential, but the choices
-rarely change from one sample to the next. An update guesses the previous choices,
-runs the scalar recursion along them in plain Python floats, and checks all
-selectors with one masked argmin over the pool; only from the first wrong guess on
-(mostly among the last, weakest selectors) does it fall back to the step-by-step
-loop. Every weight is computed by the same floating-point operations either way,
-so the results are those of the plain loop, bit for bit
-(``tests/track/test_boosting_speed_equivalence.py`` keeps the plain implementation
-as the reference). The integral histogram of a sample does not depend on the
-classifier: :meth:`OnlineBoostingClassifier.learn` and
+Speed: the importance recursion over the selectors is sequential, one selector
+after the other over the whole pool, so numpy can only vectorise each step and
+pays its call overhead ``selectors`` times per sample. The per-weight part of an
+update (running means, the weak hypotheses' verdicts, the selector recursion with
+its weight and importance updates) is one loop compiled with numba
+(:func:`_learn_step`); so are the exchange's choice and bookkeeping
+(:func:`_exchange`) and the integral histograms (:func:`_integrate`). They are
+compiled without ``fastmath`` and compute every value by the same floating-point
+operations in the same order as the plain numpy implementation, so the results
+are those of the plain implementation, bit for bit
+(``tests/track/test_boosting_speed_equivalence.py`` keeps it as the reference).
+What numpy computes with BLAS or its own reductions (the features, the exchange's
+mean errors and new weights, the votes' logarithms) and the random draws stay in
+numpy, so their rounding and the random streams are unchanged. The kernels compile
+on first use (about a second) and are cached on disk (``cache=True``). The
+integral histogram of a sample does not depend on the classifier:
+:meth:`OnlineBoostingClassifier.learn` and
 :meth:`OnlineBoostingClassifier.predict_integrals` take it precomputed, so a
 tracker computes it once per detection for all its classifiers.
 """
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
 from typing import Any
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
-from scipy.linalg import blas
 
 Array = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -85,52 +92,186 @@ def box_corners(boxes: IntArray, bins: int) -> IntArray:
     return np.asarray((c[..., 0] * side + c[..., 1]) * side + c[..., 2], dtype=np.int64)
 
 
-def _one_box_corners(box: list[list[int]], bins: int) -> list[int]:
-    """:func:`box_corners` of one box ``[[r0, r1], [g0, g1], [b0, b1]]`` with Python ints."""
-    side = bins + 1
-    (r0, r1), (g0, g1), (b0, b1) = box
-    out: list[int] = []
-    for r in (r0, r1 + 1):
-        for g in (g0, g1 + 1):
-            out.extend(((r * side + g) * side + b0, (r * side + g) * side + b1 + 1))
-    return out
-
-
 def integral_histograms(histograms: NDArray[np.float64], bins: int) -> NDArray[np.float64]:
-    """Zero-padded cumulative sums ``(..., (bins+1)**3)`` of flattened ``bins**3`` histograms."""
+    """Zero-padded cumulative sums ``(..., (bins+1)**3)`` of flattened ``bins**3`` histograms.
+
+    The sums of numpy's ``cube.cumsum(-1).cumsum(-2).cumsum(-3)``, in the same order
+    (compiled: :func:`_integrate`).
+    """
     lead = histograms.shape[:-1]
-    cube = histograms.reshape(*lead, bins, bins, bins)
-    out = np.zeros((*lead, bins + 1, bins + 1, bins + 1))
-    out[..., 1:, 1:, 1:] = cube.cumsum(-1).cumsum(-2).cumsum(-3)
+    flat = np.ascontiguousarray(histograms, dtype=np.float64).reshape(-1, bins**3)
+    out = np.zeros((len(flat), (bins + 1) ** 3))
+    _integrate_kernel(flat, bins, out)
     return out.reshape(*lead, (bins + 1) ** 3)
 
 
-def _recursion(
-    values: list[float], guess_correct: list[bool], totals: list[float]
-) -> tuple[list[float], list[float]]:
-    """Oza's importance along guessed choices: each selector's lambda and weighted error.
+def _integrate(histograms: Array, bins: int, out: Array) -> None:
+    """Cumulative sums of ``histograms`` ``(D, bins**3)`` into the zeroed ``out[:, 1:, 1:, 1:]``.
 
-    ``values`` are the chosen hypotheses' wrong weights before the sample,
-    ``guess_correct`` whether they are right on it, ``totals`` the selectors' totals.
+    ``out`` is ``(D, (bins+1)**3)``, a zero layer first on each axis. The sums run
+    along b, then g, then r, each from the second entry on: ``s[i] = s[i-1] + x[i]``,
+    the additions of numpy's cumulative sums.
     """
+    s = bins + 1
+    for d in range(histograms.shape[0]):
+        h, o = histograms[d], out[d]
+        for r in range(bins):
+            for g in range(bins):
+                src, dst = (r * bins + g) * bins, ((r + 1) * s + g + 1) * s + 1
+                acc = h[src]
+                o[dst] = acc
+                for b in range(1, bins):
+                    acc = acc + h[src + b]
+                    o[dst + b] = acc
+        for r in range(1, s):  # along g
+            for g in range(2, s):
+                for b in range(1, s):
+                    i = (r * s + g) * s + b
+                    o[i] = o[i - s] + o[i]
+        for r in range(2, s):  # along r
+            for g in range(1, s):
+                for b in range(1, s):
+                    i = (r * s + g) * s + b
+                    o[i] = o[i - s * s] + o[i]
+
+
+def _select(
+    miss: NDArray[np.bool_], wrong: Array, total: Array, selected: IntArray, errors: Array
+) -> None:
+    """Selectors in turn, in place: weigh the pool, take the best free hypothesis, pass lambda on.
+
+    ``miss`` says which weak hypotheses are wrong on the sample. Selector ``n`` adds
+    its importance ``lam`` to the wrong weights ``wrong[n]`` of the missing ones and
+    to its total ``total[n]``, takes the first hypothesis with the lowest wrong weight
+    among those no earlier selector took, stores it in ``selected[n]`` and its error
+    in ``errors[n]``, and passes on Oza's importance. ``lam * miss`` is ``lam`` or
+    ``0.0``, so adding ``lam`` or ``0.0`` gives the plain loop's weights.
+    """
+    N, M = wrong.shape
+    taken = np.zeros(M)  # inf for the hypotheses earlier selectors took
+    free = np.empty(M)  # this selector's weights, inf where taken
     lam = 1.0
-    lams: list[float] = []
-    errors: list[float] = []
-    for w, ok, total in zip(values, guess_correct, totals, strict=True):
-        e = (w if ok else w + lam) / (total + lam)
-        lams.append(lam)
-        errors.append(e)
-        lam = lam / (2.0 * (1.0 - e)) if ok else lam / (2.0 * e)
-    return lams, errors
+    for n in range(N):
+        for j in range(M):
+            w = wrong[n, j] + (lam if miss[j] else 0.0)
+            wrong[n, j] = w
+            free[j] = w + taken[j]
+        # the minimum by four running minima (exact in any order), then numpy's argmin:
+        # the first index that holds it
+        a0 = a1 = a2 = a3 = np.inf
+        j = 0
+        while j + 4 <= M:
+            x0, x1, x2, x3 = free[j], free[j + 1], free[j + 2], free[j + 3]
+            a0 = x0 if x0 < a0 else a0
+            a1 = x1 if x1 < a1 else a1
+            a2 = x2 if x2 < a2 else a2
+            a3 = x3 if x3 < a3 else a3
+            j += 4
+        for i in range(j, M):
+            a0 = free[i] if free[i] < a0 else a0
+        a0 = a1 if a1 < a0 else a0
+        a2 = a3 if a3 < a2 else a2
+        best = a2 if a2 < a0 else a0
+        m = 0
+        while free[m] != best:
+            m += 1
+        e = best / (total[n] + lam)
+        total[n] += lam
+        taken[m] = np.inf
+        selected[n] = m
+        errors[n] = e
+        lam = lam / (2.0 * e) if miss[m] else lam / (2.0 * (1.0 - e))
 
 
-def _add_outer(W: Array, lams: list[float], miss: Array) -> Array:
-    """``W + outer(lams, miss)`` for 0/1 ``miss``, by BLAS ``dger`` on the transpose.
+def _learn_step(
+    f: Array,
+    positive: bool,
+    rate: float,
+    mean: Array,
+    count: Array,
+    wrong: Array,
+    total: Array,
+    selected: IntArray,
+    errors: Array,
+    scale: Array,
+) -> None:
+    """One sample of features ``f`` in place: running means, verdicts, then :func:`_select`.
 
-    Each product ``lam * miss`` is exact, so the fused or plain addition rounds the same
-    as numpy's ``W + lams[:, None] * miss``; ``dger`` avoids the temporary product.
+    The gain of the running mean is ``max(1 / (count + 1), rate)``; a weak hypothesis
+    says "positive" on the positive side of the midpoint of its two means. ``scale``
+    gets ``1 / (N total)``, the selectors' weights in the hypotheses' mean error.
     """
-    return np.asarray(blas.dger(1.0, miss, np.asarray(lams), a=W.T).T, dtype=np.float64)
+    M = f.shape[0]
+    k = 1 if positive else 0
+    miss = np.empty(M, dtype=np.bool_)
+    for j in range(M):
+        gain = 1.0 / (count[k, j] + 1.0)
+        if gain < rate:
+            gain = rate
+        mean[k, j] += gain * (f[j] - mean[k, j])
+        count[k, j] += 1.0
+        neg, pos = mean[0, j], mean[1, j]
+        threshold = 0.5 * (neg + pos)
+        says_positive = f[j] > threshold if pos >= neg else f[j] < threshold
+        miss[j] = says_positive != positive
+    _select_kernel(miss, wrong, total, selected, errors)
+    N = total.shape[0]
+    for n in range(N):
+        scale[n] = 1.0 / (N * total[n])
+
+
+def _exchange(
+    mean_error: Array,
+    selected: IntArray,
+    box: IntArray,
+    bins: int,
+    boxes: IntArray,
+    corners: IntArray,
+    mean: Array,
+    count: Array,
+) -> int:
+    """Replace the unselected hypothesis of highest ``mean_error`` by ``box``; its index or -1.
+
+    The first of the highest (numpy's argmax), -1 when every hypothesis is selected.
+    The new hypothesis gets the box, its :func:`box_corners` and empty running means;
+    ``mean_error`` is scratch.
+    """
+    for n in range(selected.shape[0]):
+        mean_error[selected[n]] = -np.inf
+    m = 0
+    for j in range(1, mean_error.shape[0]):
+        if mean_error[j] > mean_error[m]:
+            m = j
+    if mean_error[m] == -np.inf:
+        return -1
+    side = bins + 1
+    for k in range(8):  # face of r, g, b: bits 2, 1, 0 of k (lower 0, upper 1)
+        r = box[0, 0] if k & 4 == 0 else box[0, 1] + 1
+        g = box[1, 0] if k & 2 == 0 else box[1, 1] + 1
+        b = box[2, 0] if k & 1 == 0 else box[2, 1] + 1
+        corners[m, k] = (r * side + g) * side + b
+    for axis in range(3):
+        boxes[m, axis, 0] = box[axis, 0]
+        boxes[m, axis, 1] = box[axis, 1]
+    for row in range(2):
+        mean[row, m] = 0.0
+        count[row, m] = 0.0
+    return m
+
+
+#: :func:`_integrate`, :func:`_select`, :func:`_learn_step` and :func:`_exchange` compiled
+#: (on first use; cached on disk). No ``fastmath``: the operations are rounded one by one, as
+#: in numpy.
+_integrate_kernel: Callable[[Array, int, Array], None] = numba.njit(cache=True)(_integrate)
+_select_kernel: Callable[[NDArray[np.bool_], Array, Array, IntArray, Array], None] = numba.njit(
+    cache=True
+)(_select)
+_learn_kernel: Callable[
+    [Array, bool, float, Array, Array, Array, Array, IntArray, Array, Array], None
+] = numba.njit(cache=True)(_learn_step)
+_exchange_kernel: Callable[
+    [Array, IntArray, IntArray, int, IntArray, IntArray, Array, Array], int
+] = numba.njit(cache=True)(_exchange)
 
 
 class OnlineBoostingClassifier:
@@ -176,11 +317,8 @@ class OnlineBoostingClassifier:
         self._total = np.full(N, 2.0 * _INITIAL_WEIGHT)
         self._selected = np.zeros(N, dtype=np.int64)
         self._alpha: Array | None = np.zeros(N)  # None: derive from _errors when needed
-        self._errors: list[float] = []
-        # _boost's check: flat indices of (selector n, column of the choice of selector k < n)
-        self._rows = np.arange(N)
-        taken_rows, self._taken_by = np.tril_indices(N, -1)
-        self._taken_base = taken_rows * M
+        self._errors = np.zeros(N)  # the selectors' errors on the last sample
+        self._error_scale = np.zeros(N)  # 1 / (N total): mean error = _error_scale @ _wrong
         self.positives = 0
         self.negatives = 0
 
@@ -240,12 +378,19 @@ class OnlineBoostingClassifier:
     def learn(self, integral: Array, positive: bool) -> None:
         """:meth:`update` given the sample's :func:`integral_histograms` ``((bins+1)**3,)``."""
         f = np.asarray(integral.take(self._corners) @ CORNER_SIGNS, dtype=np.float64)
-        k = 1 if positive else 0
-        gain = np.maximum(1.0 / (self._count[k] + 1.0), self._rate)
-        self._mean[k] += gain * (f - self._mean[k])
-        self._count[k] += 1.0
-        correct = self._hypotheses(f, None) == positive
-        self._boost(correct)
+        _learn_kernel(
+            f,
+            bool(positive),
+            self._rate,
+            self._mean,
+            self._count,
+            self._wrong,
+            self._total,
+            self._selected,
+            self._errors,
+            self._error_scale,
+        )
+        self._alpha = None  # only predictions need the votes: derived on demand
         self._exchange_worst()
         if positive:
             self.positives += 1
@@ -274,114 +419,29 @@ class OnlineBoostingClassifier:
             )
         return h
 
-    def _hypotheses(self, f: Array, columns: IntArray | None) -> NDArray[np.bool_]:
-        """Which weak hypotheses say "positive" for features ``f`` (of ``columns``)."""
-        mean = self._mean if columns is None else self._mean[:, columns]
+    def _hypotheses(self, f: Array, columns: IntArray) -> NDArray[np.bool_]:
+        """Which weak hypotheses ``columns`` say "positive" for their features ``f``."""
+        mean = self._mean[:, columns]
         neg, pos = mean[0], mean[1]
         threshold = 0.5 * (neg + pos)
         return np.asarray(np.where(pos >= neg, f > threshold, f < threshold), dtype=bool)
 
-    def _boost(self, correct: NDArray[np.bool_]) -> None:
-        """Selectors in turn: weigh the pool, take the best free hypothesis, pass lambda on.
-
-        The choices are those of the plain sequential recursion (:meth:`_boost_from`),
-        found faster: guess that every selector takes the same hypothesis as on the
-        previous sample, run the scalar importance recursion along that guess, and check
-        every selector at once (one masked argmin over the pool). If each selector's
-        argmin is its guess, the guess is the recursion's result (by induction over the
-        selectors). Otherwise the selectors before the first mismatch are right, the
-        mismatched one is right with its argmin, and the sequential loop finishes from
-        there. Every weight is computed by the same floating-point operations as in the
-        sequential loop, so the results are the same bit for bit.
-        """
-        W = self._wrong
-        miss = (~correct).astype(np.float64)
-        guess = self._selected
-        totals = self._total.tolist()
-        lams, errors = _recursion(W[self._rows, guess].tolist(), correct[guess].tolist(), totals)
-        new_wrong = _add_outer(W, lams, miss)
-        masked = new_wrong.copy()
-        masked.ravel()[self._taken_base + guess[self._taken_by]] = np.inf
-        best = masked.argmin(axis=1)
-        mismatched = np.flatnonzero(best != guess)
-        if len(mismatched) == 0:
-            self._finish(new_wrong, np.asarray(lams), errors, guess.copy())
-            return
-        # selectors before p took their guess; selector p takes its masked argmin
-        p = int(mismatched[0])
-        chosen = [*guess[:p].tolist(), int(best[p])]
-        is_correct = correct.tolist()
-        lam = lams[p]
-        e = float(new_wrong[p, chosen[p]]) / (totals[p] + lam)
-        errors[p] = e
-        lam_next = lam / (2.0 * (1.0 - e)) if is_correct[chosen[p]] else lam / (2.0 * e)
-        del lams[p + 1 :], errors[p + 1 :]
-        self._boost_from(new_wrong, chosen, lams, errors, lam_next, miss, is_correct)
-
-    def _boost_from(
-        self,
-        new_wrong: Array,
-        chosen: list[int],
-        lams: list[float],
-        errors: list[float],
-        lam: float,
-        miss: Array,
-        is_correct: list[bool],
-    ) -> None:
-        """The sequential recursion from selector ``start = len(chosen)`` on, lambda ``lam``.
-
-        The earlier selectors' choices, lambdas, errors and rows of ``new_wrong`` are
-        given; the rest are filled in.
-        """
-        N = self._wrong.shape[0]
-        start = len(chosen)
-        if start < N:
-            # scratch copy: row n becomes the wrong weights after this sample; hypotheses
-            # taken by earlier selectors are inf. miss is 0/1, so lam * miss + w is exact.
-            work = self._wrong[start:].copy()
-            work[:, chosen] = np.inf
-            total = self._total.tolist()
-            daxpy = blas.daxpy
-            for j, row in enumerate(work, start + 1):  # row of selector j - 1, over the pool
-                row = daxpy(miss, row, a=lam)  # in place: row += lam * miss
-                m = int(row.argmin())
-                e = row.item(m) / (total[j - 1] + lam)
-                work[j - start :, m] = np.inf
-                chosen.append(m)
-                errors.append(e)
-                lams.append(lam)
-                lam = lam / (2.0 * (1.0 - e)) if is_correct[m] else lam / (2.0 * e)
-            new_wrong[start:] = _add_outer(self._wrong[start:], lams[start:], miss)
-        self._finish(new_wrong, np.asarray(lams), errors, np.asarray(chosen, dtype=np.int64))
-
-    def _finish(self, wrong: Array, lams: Array, errors: list[float], chosen: IntArray) -> None:
-        """Store a sample's new weights, choices and votes."""
-        self._wrong = wrong
-        self._total += lams
-        self._errors = errors
-        self._selected = chosen
-        self._alpha = None  # only predictions need the votes: derived on demand
-
     def _votes(self) -> Array:
         """``alpha_n = 1/2 ln((1 - e_n)/e_n)``, 0 when ``e_n >= 1/2``, of the last sample's errors."""
         if self._alpha is None:
-            err = np.asarray(self._errors)
+            err = self._errors
             self._alpha = np.where(err < 0.5, 0.5 * np.log((1.0 - err) / err), 0.0)
         return self._alpha
 
     def _exchange_worst(self) -> None:
-        mean_error = (1.0 / (len(self._total) * self._total)) @ self._wrong
-        mean_error[self._selected] = -math.inf
-        m = int(mean_error.argmax())
-        if mean_error[m] == -math.inf:
+        mean_error = self._error_scale @ self._wrong
+        box = self._spare_boxes[self._spare_next]
+        args = (self._boxes, self._corners, self._mean, self._count)
+        m = _exchange_kernel(mean_error, self._selected, box, self.bins, *args)
+        if m < 0:
             return  # every weak hypothesis is in use
-        if self._spare_next >= len(self._spare_boxes):
+        self._wrong[:, m] = self._wrong @ self._mean_weights
+        self._spare_next += 1
+        if self._spare_next == len(self._spare_boxes):  # draw the next block
             self._spare_boxes = random_boxes(self._rng, len(self._boxes), self.bins)
             self._spare_next = 0
-        box = self._spare_boxes[self._spare_next]
-        self._spare_next += 1
-        self._boxes[m] = box
-        self._corners[m] = _one_box_corners(box.tolist(), self.bins)
-        self._mean[:, m] = 0.0
-        self._count[:, m] = 0.0
-        self._wrong[:, m] = self._wrong @ self._mean_weights
