@@ -1,0 +1,292 @@
+"""The vectorised detector code gives the same results as the straightforward one.
+
+The ``reference_*`` functions below are the implementations before the speed-up
+(``np.maximum.at`` height maps, ``ndimage`` filters and labelling, one cluster
+at a time), kept verbatim but for their docstrings. The tests drive both with
+random clouds and compare the outputs exactly.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from numpy.typing import NDArray
+from scipy import ndimage
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
+
+from rgbd_eval.detect import clustering
+from rgbd_eval.detect.clustering import (
+    HEAD_SEARCH_RADIUS,
+    OVERHANG_GAP,
+    PERSON_MAX_WIDTH,
+    group_extrema,
+    merge_close_clusters,
+    split_by_heads,
+)
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+SEEDS = st.integers(0, 2**32 - 1)
+
+# ---------------------------------------------------------------- references
+
+
+def reference_merge_close_clusters(
+    ground_xy: FloatArray,
+    labels: IntArray,
+    distance: float,
+    heights: FloatArray | None = None,
+    max_height: float = np.inf,
+) -> IntArray:
+    """Merge person-sized clusters whose mean ground positions are closer than ``distance``."""
+    k = int(labels.max()) + 1 if labels.size else 0
+    if k < 2:
+        return labels
+    valid = labels >= 0
+    lab = labels[valid]
+    xy = ground_xy[valid]
+    counts = np.bincount(lab, minlength=k).astype(np.float64)
+    centres = (
+        np.stack([np.bincount(lab, weights=xy[:, j], minlength=k) for j in (0, 1)], axis=1)
+        / np.maximum(counts, 1.0)[:, None]
+    )
+    lo = np.full((k, 2), np.inf)
+    hi = np.full((k, 2), -np.inf)
+    for j in (0, 1):
+        np.minimum.at(lo[:, j], lab, xy[:, j])
+        np.maximum.at(hi[:, j], lab, xy[:, j])
+    mergeable = np.hypot(*(hi - lo).T) <= PERSON_MAX_WIDTH
+    if heights is not None:
+        top = np.full(k, -np.inf)
+        np.maximum.at(top, lab, heights[valid])
+        mergeable &= top <= max_height
+    candidates = np.flatnonzero(mergeable & (counts > 0))
+    if candidates.shape[0] < 2:
+        return labels
+    pairs = candidates[cKDTree(centres[candidates]).query_pairs(distance, output_type="ndarray")]
+    if pairs.shape[0] == 0:
+        return labels
+    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
+    _, merged = connected_components(graph, directed=False)
+    out = labels.copy()
+    out[valid] = merged[lab]
+    return clustering.filter_cluster_sizes(out, 1, None)
+
+
+def reference_height_map(
+    ground_xy: FloatArray, heights: FloatArray, cell: float, max_height: float
+) -> tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]]:
+    """Highest point per ground cell, with overhangs taken out."""
+    origin = ground_xy.min(axis=0)
+    ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1
+    shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
+    high = heights > max_height
+    hmap = np.zeros(shape, dtype=np.float64)
+    np.maximum.at(hmap, (ij[~high, 0], ij[~high, 1]), heights[~high])
+    overhang = np.zeros(heights.shape, dtype=bool)
+    if np.any(high):
+        lowest_high = np.full(shape, np.inf)
+        np.minimum.at(lowest_high, (ij[high, 0], ij[high, 1]), heights[high])
+        top_high = np.zeros(shape)
+        np.maximum.at(top_high, (ij[high, 0], ij[high, 1]), heights[high])
+        floor_of_gap = np.maximum(hmap, max_height - OVERHANG_GAP)
+        tall = np.isfinite(lowest_high) & (lowest_high - floor_of_gap <= OVERHANG_GAP)
+        hmap[tall] = top_high[tall]
+        overhang = high & ~tall[ij[:, 0], ij[:, 1]]
+    return hmap, ij, origin, overhang
+
+
+def reference_head_seeds(
+    hmap: FloatArray,
+    cell: float,
+    min_head_distance: float,
+    min_head_prominence: float,
+    head_heights: tuple[float, float],
+) -> tuple[IntArray, list[FloatArray]]:
+    """Seed regions of the map (0 = none): the heads first (1..H), then tall structures."""
+    lowest, highest = head_heights
+    seeds = np.zeros(hmap.shape, dtype=np.int64)
+    tall = hmap > highest
+    radius = max(1, int(np.floor(0.5 * min_head_distance / cell)))
+    yy, xx = np.mgrid[-radius : radius + 1, -radius : radius + 1]
+    disk = yy * yy + xx * xx <= radius * radius
+    peaks = (
+        (hmap >= lowest)
+        & ~tall
+        & (hmap >= ndimage.maximum_filter(hmap, footprint=disk, mode="constant"))
+    )
+    pi, pj = np.nonzero(peaks)
+    order = np.lexsort((pj, pi, -hmap[pi, pj]))
+    half = max(1, int(np.ceil(HEAD_SEARCH_RADIUS / cell)))
+    eight = np.ones((3, 3), dtype=bool)
+    min_cells2 = (min_head_distance / cell) ** 2
+    accepted: list[tuple[int, int]] = []
+    centres: list[FloatArray] = []
+    for i, j in zip(pi[order].tolist(), pj[order].tolist(), strict=True):
+        if any((i - a) ** 2 + (j - b) ** 2 < min_cells2 for a, b in accepted):
+            continue
+        i0, j0 = max(0, i - half), max(0, j - half)
+        window = hmap[i0 : i + half + 1, j0 : j + half + 1]
+        regions, _ = ndimage.label(window >= hmap[i, j] - min_head_prominence, structure=eight)
+        mine = regions == regions[i - i0, j - j0]
+        taken = seeds[i0 : i + half + 1, j0 : j + half + 1]
+        if np.any(mine & ((taken > 0) | (window > highest))):
+            continue
+        accepted.append((i, j))
+        taken[mine] = len(accepted)
+        ri, rj = np.nonzero(mine)
+        centres.append(np.array([ri.mean() + i0, rj.mean() + j0]))
+    tall_regions, _ = ndimage.label(tall, structure=eight)
+    seeds[tall] = tall_regions[tall] + len(accepted)
+    return seeds, centres
+
+
+def reference_split_by_heads(
+    ground_xy: FloatArray,
+    heights: FloatArray,
+    labels: IntArray,
+    cell: float,
+    min_head_distance: float,
+    min_head_prominence: float,
+    head_heights: tuple[float, float] = (0.0, np.inf),
+) -> IntArray:
+    """Split every cluster between its heads and taller structures."""
+    out = np.full(labels.shape, -1, dtype=np.int64)
+    next_label = 0
+    k = int(labels.max()) + 1 if labels.size else 0
+    members_sorted = np.argsort(labels, kind="stable")
+    bounds = np.searchsorted(labels[members_sorted], np.arange(k + 1))
+    for c in range(k):
+        members = members_sorted[bounds[c] : bounds[c + 1]]
+        hmap, ij, _, overhang = reference_height_map(
+            ground_xy[members], heights[members], cell, head_heights[1]
+        )
+        seeds, heads = reference_head_seeds(
+            hmap, cell, min_head_distance, min_head_prominence, head_heights
+        )
+        n_seeds = int(seeds.max())
+        if not heads:
+            out[members] = next_label
+            next_label += 1
+            continue
+        if n_seeds == 1:
+            sub = np.zeros(members.shape[0], dtype=np.int64)
+        else:
+            _, (ni, nj) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
+            sub = seeds[ni, nj][ij[:, 0], ij[:, 1]] - 1
+        out[members] = np.where(overhang, -1, next_label + sub)
+        next_label += n_seeds
+    return clustering.filter_cluster_sizes(out, 1, None)
+
+
+# ---------------------------------------------------------------- random scenes
+
+
+def people_scene(seed: int) -> tuple[FloatArray, FloatArray, IntArray]:
+    """Ground positions, heights and cluster labels of a few random people, walls and shelves.
+
+    People are head-and-shoulder bumps (sometimes two in one cluster), walls are
+    tall columns reaching the floor, shelves are overhangs above ``max_height``,
+    pieces lie next to the previous cluster (to be merged with it).
+    """
+    rng = np.random.default_rng(seed)
+    xy_parts, h_parts, labels = [], [], []
+    centre = rng.uniform(-1.5, 1.5, 2)
+    for c in range(int(rng.integers(1, 6))):
+        kind = rng.choice(["person", "pair", "wall", "shelf", "low", "piece"])
+        if kind != "piece":
+            centre = rng.uniform(-1.5, 1.5, 2)
+        n = int(rng.integers(5, 300))
+        if kind in ("person", "pair"):
+            heads = [centre] if kind == "person" else [centre, centre + rng.uniform(-0.7, 0.7, 2)]
+            pts = []
+            for head in heads:
+                offsets = rng.normal(0, 0.1, (n, 2))
+                r = np.hypot(*offsets.T)
+                top = rng.uniform(1.4, 2.0)
+                pts.append((head + offsets, np.clip(top - 1.5 * r * r, 0.1, None)))
+            xy = np.vstack([p[0] for p in pts])
+            h = np.concatenate([p[1] for p in pts]) * rng.uniform(0.3, 1.0, len(pts) * n)
+        elif kind == "wall":
+            xy = centre + np.column_stack([rng.uniform(0, 2, n), rng.normal(0, 0.02, n)])
+            h = rng.uniform(0.1, 2.8, n)
+        elif kind == "shelf":
+            xy = centre + rng.uniform(-0.5, 0.5, (n, 2))
+            h = np.where(rng.random(n) < 0.5, rng.uniform(2.4, 2.6, n), rng.uniform(0.1, 1.9, n))
+        elif kind == "low":
+            xy = centre + rng.uniform(-0.4, 0.4, (n, 2))
+            h = rng.uniform(0.1, 1.0, n)
+        else:  # a piece near the previous cluster's centre (a head cut from its body)
+            xy = centre + rng.uniform(-0.25, 0.25, 2) + rng.normal(0, 0.05, (n, 2))
+            h = rng.uniform(1.2, 2.0, n)
+        xy_parts.append(xy)
+        h_parts.append(h)
+        labels.append(np.full(len(h), c))
+    order = rng.permutation(sum(len(h) for h in h_parts))
+    lab = np.concatenate(labels)[order]
+    lab[rng.random(lab.shape[0]) < 0.05] = -1  # a few unclustered points
+    return np.vstack(xy_parts)[order], np.concatenate(h_parts)[order], lab
+
+
+# ---------------------------------------------------------------- tests
+
+
+@settings(max_examples=100, deadline=None)
+@given(SEEDS, st.integers(1, 30), st.integers(0, 400))
+def test_group_extrema_match_ufunc_at(seed: int, k: int, n: int) -> None:
+    rng = np.random.default_rng(seed)
+    groups = rng.integers(0, k, n)
+    values = rng.normal(size=(n, 2))
+    lo, hi = group_extrema(groups, values, k)
+    want_lo, want_hi = np.full((k, 2), np.inf), np.full((k, 2), -np.inf)
+    np.minimum.at(want_lo, groups, values)
+    np.maximum.at(want_hi, groups, values)
+    assert np.array_equal(lo, want_lo)
+    assert np.array_equal(hi, want_hi)
+
+
+@settings(max_examples=100, deadline=None)
+@given(SEEDS, st.integers(1, 25), st.integers(1, 25), st.integers(1, 4))
+def test_map_filter_and_labels_match_ndimage(seed: int, rows: int, cols: int, radius: int) -> None:
+    rng = np.random.default_rng(seed)
+    image = np.where(rng.random((rows, cols)) < 0.3, 0.0, rng.normal(1.0, 1.0, (rows, cols)))
+    yy, xx = np.mgrid[-radius : radius + 1, -radius : radius + 1]
+    disk = yy * yy + xx * xx <= radius * radius
+    want = ndimage.maximum_filter(image, footprint=disk, mode="constant")
+    assert np.array_equal(clustering._maximum_filter(image, radius), want)
+    mask = image > 0.8
+    ours = clustering._components8(mask)
+    theirs, _ = ndimage.label(mask, structure=np.ones((3, 3), dtype=bool))
+    # The same partition: a one-to-one map between the two labellings.
+    pairs = np.unique(np.stack([ours.ravel(), theirs.ravel()]), axis=1)
+    assert np.unique(pairs[0]).size == np.unique(pairs[1]).size == pairs.shape[1]
+
+
+@settings(max_examples=150, deadline=None)
+@given(SEEDS)
+def test_height_map_matches_reference(seed: int) -> None:
+    xy, h, _ = people_scene(seed)
+    got = clustering._height_map(xy, h, 0.06, 2.3)
+    want = reference_height_map(xy, h, 0.06, 2.3)
+    for a, b in zip(got, want, strict=True):
+        assert np.array_equal(a, b)
+
+
+@settings(max_examples=150, deadline=None)
+@given(SEEDS, st.sampled_from([(1.4, 2.3), (0.0, np.inf), (-1.0, 2.0)]))
+def test_subclustering_matches_reference(seed: int, head_heights: tuple[float, float]) -> None:
+    xy, h, labels = people_scene(seed)
+    merged = merge_close_clusters(xy, labels, 0.3, h, head_heights[1])
+    assert np.array_equal(
+        merged, reference_merge_close_clusters(xy, labels, 0.3, h, head_heights[1])
+    )
+    assert np.array_equal(
+        merge_close_clusters(xy, labels, 0.3), reference_merge_close_clusters(xy, labels, 0.3)
+    )
+    got = split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
+    want = reference_split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
+    assert np.array_equal(got, want)
