@@ -2,7 +2,8 @@
 
 The ``reference_*`` functions below are the implementations before the speed-up
 (``np.maximum.at`` height maps, ``ndimage`` filters and labelling, one cluster
-at a time), kept verbatim but for their docstrings. The tests drive both with
+at a time; blob masks over the whole image), kept verbatim but for their
+docstrings. The tests drive both with
 random clouds and compare the outputs exactly.
 """
 
@@ -26,6 +27,9 @@ from rgbd_eval.detect.clustering import (
     merge_close_clusters,
     split_by_heads,
 )
+from rgbd_eval.detect.features import blob, colour_histogram
+from rgbd_eval.detect.plane import cross3
+from rgbd_eval.types import CameraModel
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -183,6 +187,37 @@ def reference_split_by_heads(
     return clustering.filter_cluster_sizes(out, 1, None)
 
 
+def reference_blob_pixels(uv: FloatArray, footprint: int, rgb_camera: CameraModel) -> IntArray:
+    """Flat RGB-image indices of the blob: each projected point covers ``footprint^2`` pixels."""
+    if uv.shape[0] == 0:
+        return np.zeros(0, dtype=np.int64)
+    k = max(1, int(footprint))
+    offsets = np.arange(k, dtype=np.float64) - (k - 1) / 2.0
+    du, dv = np.meshgrid(offsets, offsets)
+    u = np.rint(uv[:, 0:1] + du.reshape(1, -1)).astype(np.int64).reshape(-1)
+    v = np.rint(uv[:, 1:2] + dv.reshape(1, -1)).astype(np.int64).reshape(-1)
+    ok = (u >= 0) & (u < rgb_camera.width) & (v >= 0) & (v < rgb_camera.height)
+    mask = np.zeros(rgb_camera.width * rgb_camera.height, dtype=bool)
+    mask[v[ok] * rgb_camera.width + u[ok]] = True
+    pixels: IntArray = np.flatnonzero(mask).astype(np.int64)
+    return pixels
+
+
+def reference_colour_histogram(
+    rgb: NDArray[np.uint8], pixels: IntArray, bins: int
+) -> NDArray[np.float32]:
+    """Flattened 3D RGB histogram (``bins**3`` values, R slowest) normalised to sum 1."""
+    size = bins**3
+    if pixels.shape[0] == 0:
+        return np.full(size, 1.0 / size, dtype=np.float32)
+    flat = rgb.reshape(-1, rgb.shape[-1])
+    lut = np.arange(256, dtype=np.intp) * bins // 256
+    index = (lut[flat[pixels, 0]] * bins + lut[flat[pixels, 1]]) * bins + lut[flat[pixels, 2]]
+    hist = np.bincount(index, minlength=size).astype(np.float64)
+    out: NDArray[np.float32] = (hist / hist.sum()).astype(np.float32)
+    return out
+
+
 # ---------------------------------------------------------------- random scenes
 
 
@@ -290,3 +325,28 @@ def test_subclustering_matches_reference(seed: int, head_heights: tuple[float, f
     got = split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
     want = reference_split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
     assert np.array_equal(got, want)
+
+
+@settings(max_examples=150, deadline=None)
+@given(SEEDS, st.integers(0, 400), st.integers(1, 6), st.sampled_from([1, 3, 8, 16]))
+def test_blob_and_histogram_match_reference(seed: int, n: int, footprint: int, bins: int) -> None:
+    rng = np.random.default_rng(seed)
+    camera = CameraModel(64, 48, 50.0, 50.0, 31.5, 23.5)
+    # Points on and off the image, some on pixel centres and half-pixels (rounding ties).
+    uv = rng.uniform(-10, 74, (n, 2))
+    uv[: n // 3] = np.round(uv[: n // 3] * 2) / 2
+    rgb = rng.integers(0, 256, (48, 64, 3), dtype=np.uint8)
+    b = blob(uv, footprint, camera)
+    rows, cols = np.nonzero(b.mask)
+    want = reference_blob_pixels(uv, footprint, camera)
+    assert np.array_equal((rows + b.top) * camera.width + (cols + b.left), want)
+    got_hist = colour_histogram(rgb, b, bins)
+    assert np.array_equal(got_hist, reference_colour_histogram(rgb, want, bins))
+
+
+@settings(max_examples=200, deadline=None)
+@given(SEEDS)
+def test_cross3_is_np_cross(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=(2, 3)) * rng.choice([1e-3, 1.0, 1e3], (2, 3))
+    assert np.array_equal(cross3(a, b), np.cross(a, b))

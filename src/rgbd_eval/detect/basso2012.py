@@ -28,12 +28,14 @@ from rgbd_eval.detect.clustering import (
     euclidean_clusters,
     filter_cluster_sizes,
     ground_basis,
+    group_extrema,
     merge_close_clusters,
     split_by_heads,
 )
 from rgbd_eval.detect.features import (
     ClusterGeometry,
-    blob_pixels,
+    RgbProjection,
+    blob,
     box_inside_image,
     cluster_geometry,
     colour_histogram,
@@ -208,7 +210,11 @@ class Basso2012Detector:
         if k == 0:
             return []
         pts = grid.centroids[above]
-        # Full-resolution points inherit the label of their voxel.
+        # Each cluster's voxels and full-resolution points (which inherit the label of
+        # their voxel) as slices of one stable sort: the same rows, in the same order,
+        # as boolean masks, without a pass over all points per cluster.
+        voxels_sorted = np.argsort(people, kind="stable")
+        voxel_bounds = np.searchsorted(people[voxels_sorted], np.arange(k + 1))
         voxel_label = np.full(grid.centroids.shape[0], -1, dtype=np.int64)
         voxel_label[above] = people
         point_label = voxel_label[grid.point_voxel]
@@ -217,45 +223,54 @@ class Basso2012Detector:
         full_sorted = labelled[order]
         full_bounds = np.searchsorted(point_label[full_sorted], np.arange(k + 1))
 
-        uv, _ = project_to_rgb(pts, frame.depth_to_rgb, frame.rgb_camera)
+        def voxels(c: int) -> IntArray:
+            return voxels_sorted[voxel_bounds[c] : voxel_bounds[c + 1]]
+
+        def members(c: int) -> IntArray:
+            return full_sorted[full_bounds[c] : full_bounds[c + 1]]
+
+        project = RgbProjection(frame.depth_to_rgb, frame.rgb_camera)
+        uv, _ = project(pts)
         ranges = np.linalg.norm(pts, axis=1)
-        clustered = clusters >= 0
+        # Points of the (size-filtered) Euclidean clusters: the possible occluders.
+        near = np.flatnonzero(clusters >= 0)
+        near_uv, near_range, near_label = uv[near], ranges[near], people[near]
         margin = cfg.cluster_tolerance_voxels * cfg.voxel_size
         footprint = _footprint(frame)
 
         # The height filter first (5.4.2), on each cluster's highest full-resolution point.
-        tops = np.full(k, -np.inf)
-        np.maximum.at(tops, point_label[labelled], signed_heights(cloud.points[labelled], plane))
+        tops = group_extrema(
+            point_label[labelled], signed_heights(cloud.points[labelled], plane), k
+        )[1]
         in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
         geometries = {
-            int(c): cluster_geometry(
-                pts[people == c],
-                cloud.points[full_sorted[full_bounds[c] : full_bounds[c + 1]]],
+            c: cluster_geometry(
+                pts[voxels(c)],
+                cloud.points[members(c)],
                 plane,
                 cfg.head_centroid,
                 cfg.surface_correction,
             )
-            for c in in_range
+            for c in in_range.tolist()
         }
         candidates: list[tuple[float, _Candidate]] = []
         for c in sorted(geometries, key=lambda i: geometries[i].distance):  # 5.4.2: by distance
             g = geometries[c]
             if not (cfg.min_height <= g.height <= cfg.max_height) or g.distance > cfg.max_distance:
                 continue
-            mine = people == c
-            box = full_body_box(g, uv[mine], frame.depth_to_rgb, frame.rgb_camera)
+            mine = voxels(c)
+            box = full_body_box(g, uv[mine], project)
             if box is None:
                 continue
-            others = clustered & ~mine
-            members = full_sorted[full_bounds[c] : full_bounds[c + 1]]
             cut_top, cut_bottom, cut_side = _touches_border(
-                cloud.pixels[members], frame.depth_camera
+                cloud.pixels[members(c)], frame.depth_camera
             )
             in_view = box_inside_image(box, frame.rgb_camera) and not (
                 cut_top or cut_bottom or cut_side
             )
+            others = near_label != c
             occluded = (not in_view) or occluded_by_nearer_points(
-                box, float(ranges[mine].min()), uv[others], ranges[others], margin
+                box, float(ranges[mine].min()), near_uv[others], near_range[others], margin
             )
             centre_u = box.left + 0.5 * box.width
             hog_eligible = (
@@ -265,9 +280,9 @@ class Basso2012Detector:
                 and box.bottom <= frame.rgb_camera.height - 0.5
                 and 0.0 <= centre_u < frame.rgb_camera.width
             )
-            blob_uv, _ = project_to_rgb(cloud.points[members], frame.depth_to_rgb, frame.rgb_camera)
+            blob_uv, _ = project(cloud.points[members(c)])
             appearance = colour_histogram(
-                frame.rgb, blob_pixels(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
+                frame.rgb, blob(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
             )
             box3d = _world_box(frame, np.vstack([pts[mine], g.ground_point[None, :]]))
             candidates.append(
