@@ -14,8 +14,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from numpy.typing import NDArray
 from scipy import ndimage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
+from scipy.sparse import coo_matrix, csgraph
 from scipy.spatial import cKDTree
 
 from rgbd_eval.detect import clustering
@@ -24,6 +23,9 @@ from rgbd_eval.detect.clustering import (
     HEAD_SEARCH_RADIUS,
     OVERHANG_GAP,
     PERSON_MAX_WIDTH,
+    connected_components,
+    euclidean_clusters,
+    filter_cluster_sizes,
     group_extrema,
     merge_close_clusters,
     split_by_heads,
@@ -38,6 +40,37 @@ IntArray = NDArray[np.int64]
 SEEDS = st.integers(0, 2**32 - 1)
 
 # ---------------------------------------------------------------- references
+
+
+def reference_keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> IntArray:
+    """Drop labels with too few/many points; renumber the rest by first occurrence."""
+    valid = labels >= 0
+    if not np.any(valid):
+        return np.full(labels.shape, -1, dtype=np.int64)
+    uniq, first, counts = np.unique(labels[valid], return_index=True, return_counts=True)
+    keep = counts >= min_points
+    if max_points is not None:
+        keep &= counts <= max_points
+    kept = uniq[keep][np.argsort(first[keep], kind="stable")]
+    lookup = np.full(int(uniq.max()) + 1, -1, dtype=np.int64)
+    lookup[kept] = np.arange(kept.shape[0], dtype=np.int64)
+    out = np.full(labels.shape, -1, dtype=np.int64)
+    out[valid] = lookup[labels[valid]]
+    return out
+
+
+def reference_euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) -> IntArray:
+    """Connected components of the graph linking points closer than ``tolerance``."""
+    n = points.shape[0]
+    if n == 0:
+        return np.zeros(0, dtype=np.int64)
+    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
+    pairs = tree.query_pairs(tolerance, output_type="ndarray")
+    graph = coo_matrix(
+        (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)
+    )
+    _, labels = csgraph.connected_components(graph, directed=False)
+    return reference_keep_sizes(labels.astype(np.int64), min_points, None)
 
 
 def reference_merge_close_clusters(
@@ -76,10 +109,10 @@ def reference_merge_close_clusters(
     if pairs.shape[0] == 0:
         return labels
     graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
-    _, merged = connected_components(graph, directed=False)
+    _, merged = csgraph.connected_components(graph, directed=False)
     out = labels.copy()
     out[valid] = merged[lab]
-    return clustering.filter_cluster_sizes(out, 1, None)
+    return reference_keep_sizes(out, 1, None)
 
 
 def reference_height_map(
@@ -185,7 +218,7 @@ def reference_split_by_heads(
             sub = seeds[ni, nj][ij[:, 0], ij[:, 1]] - 1
         out[members] = np.where(overhang, -1, next_label + sub)
         next_label += n_seeds
-    return clustering.filter_cluster_sizes(out, 1, None)
+    return reference_keep_sizes(out, 1, None)
 
 
 def reference_voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
@@ -382,3 +415,33 @@ def test_voxel_grid_matches_reference(seed: int, n: int, size: float) -> None:
     assert np.array_equal(got.point_voxel, want.point_voxel)
     assert np.array_equal(got.counts, want.counts)
     assert np.array_equal(got.centroids, want.centroids)
+
+
+@settings(max_examples=150, deadline=None)
+@given(SEEDS, st.integers(0, 300), st.integers(0, 600))
+def test_connected_components_match_csgraph(seed: int, n: int, edges: int) -> None:
+    rng = np.random.default_rng(seed)
+    pairs = rng.integers(0, max(n, 1), (edges if n else 0, 2))
+    labels = connected_components(pairs, n)
+    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(n, n))
+    _, theirs = csgraph.connected_components(graph, directed=False)
+    # The same partition, each node labelled with the smallest node of its component.
+    smallest = np.full(theirs.max() + 1 if n else 0, n)
+    np.minimum.at(smallest, theirs, np.arange(n))
+    assert np.array_equal(labels, smallest[theirs])
+
+
+@settings(max_examples=100, deadline=None)
+@given(SEEDS, st.integers(0, 2000), st.integers(1, 40), st.sampled_from([None, 30, 200]))
+def test_clusters_and_size_filter_match_reference(
+    seed: int, n: int, min_points: int, max_points: int | None
+) -> None:
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(0, 2, (n, 3)) * rng.uniform(0.2, 1.0, 3)
+    got = euclidean_clusters(points, 0.12, min_points)
+    assert np.array_equal(got, reference_euclidean_clusters(points, 0.12, min_points))
+    labels = rng.integers(-1, 50, n) * rng.integers(1, 4)  # gaps in the numbering
+    assert np.array_equal(
+        filter_cluster_sizes(labels, min_points, max_points),
+        reference_keep_sizes(labels, min_points, max_points),
+    )

@@ -72,7 +72,7 @@ def voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
     c0, c1, c2 = (cells[:, k] - lo[k] for k in range(3))
     keys = (c0 * dims[1] + c1) * dims[2] + c2
     # Voxels numbered in key order, as np.unique would, from one stable sort of the keys.
-    order = _stable_argsort(keys, dims[0] * dims[1] * dims[2])
+    order = stable_argsort(keys, dims[0] * dims[1] * dims[2])
     sorted_keys = keys[order]
     first = np.empty(n, dtype=bool)
     first[0] = True
@@ -88,7 +88,7 @@ def voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
     return VoxelGrid(centroids=centroids, point_voxel=point_voxel, counts=counts)
 
 
-def _stable_argsort(keys: IntArray, key_count: int) -> IntArray:
+def stable_argsort(keys: IntArray, key_count: int) -> IntArray:
     """``np.argsort(keys, kind="stable")`` for keys in ``[0, key_count)``.
 
     Small keys are sorted with their index packed in the low 32 bits: a plain

@@ -30,9 +30,9 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
+
+from rgbd_eval.detect.cloud import stable_argsort
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -62,11 +62,32 @@ def euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) ->
     # Unbalanced, non-compact trees build faster and query as fast here.
     tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
     pairs = tree.query_pairs(tolerance, output_type="ndarray")
-    graph = coo_matrix(
-        (np.ones(pairs.shape[0], dtype=np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n, n)
-    )
-    _, labels = connected_components(graph, directed=False)
-    return _keep_sizes(labels.astype(np.int64), min_points, None)
+    return _keep_sizes(connected_components(pairs, n), min_points, None)
+
+
+def connected_components(pairs: IntArray, n: int) -> IntArray:
+    """Components of the undirected graph on nodes ``0..n-1`` with edges ``pairs`` ``(E, 2)``.
+
+    Each node is labelled with the smallest node of its component. Union-find on
+    whole arrays: every edge joining two trees hangs the larger root under the
+    smaller (one edge wins where several compete), then pointer jumping makes
+    every node point at its root again; edges inside one tree are dropped.
+    Several times faster than ``scipy.sparse.csgraph`` on a few thousand nodes.
+    """
+    label = np.arange(n, dtype=np.int64)
+    i, j = pairs[:, 0], pairs[:, 1]
+    while True:
+        li, lj = label[i], label[j]
+        joining = li != lj
+        if not np.any(joining):
+            return label
+        i, j, li, lj = i[joining], j[joining], li[joining], lj[joining]
+        label[np.maximum(li, lj)] = np.minimum(li, lj)
+        while True:
+            jumped = label[label]
+            if np.array_equal(jumped, label):
+                break
+            label = jumped
 
 
 def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> IntArray:
@@ -74,15 +95,19 @@ def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> In
     valid = labels >= 0
     if not np.any(valid):
         return np.full(labels.shape, -1, dtype=np.int64)
-    uniq, first, counts = np.unique(labels[valid], return_index=True, return_counts=True)
-    keep = counts >= min_points
+    lab = labels[valid]
+    k = int(lab.max()) + 1
+    counts = np.bincount(lab, minlength=k)
+    keep = counts >= max(min_points, 1)  # labels that do not occur are never kept
     if max_points is not None:
         keep &= counts <= max_points
-    kept = uniq[keep][np.argsort(first[keep], kind="stable")]
-    lookup = np.full(int(uniq.max()) + 1, -1, dtype=np.int64)
+    # Each kept label's first occurrence: the first of its run in a stable sort.
+    first = stable_argsort(lab, k)[(np.cumsum(counts) - counts)[keep]]
+    kept = np.flatnonzero(keep)[np.argsort(first)]
+    lookup = np.full(k, -1, dtype=np.int64)
     lookup[kept] = np.arange(kept.shape[0], dtype=np.int64)
     out = np.full(labels.shape, -1, dtype=np.int64)
-    out[valid] = lookup[labels[valid]]
+    out[valid] = lookup[lab]
     return out
 
 
@@ -156,8 +181,7 @@ def merge_close_clusters(
     pairs = candidates[cKDTree(centres[candidates]).query_pairs(distance, output_type="ndarray")]
     if pairs.shape[0] == 0:
         return labels
-    graph = coo_matrix((np.ones(pairs.shape[0]), (pairs[:, 0], pairs[:, 1])), shape=(k, k))
-    _, merged = connected_components(graph, directed=False)
+    merged = connected_components(pairs, k)
     out = labels.copy()
     out[valid] = merged[lab]
     return _keep_sizes(out, 1, None)
