@@ -23,7 +23,13 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.config import DetectorConfig, RunConfig
-from rgbd_eval.detect.cloud import PointCloud, VoxelGrid, depth_to_cloud, voxel_grid
+from rgbd_eval.detect.cloud import (
+    PointCloud,
+    VoxelGrid,
+    depth_to_cloud,
+    stable_argsort,
+    voxel_grid,
+)
 from rgbd_eval.detect.clustering import (
     euclidean_clusters,
     filter_cluster_sizes,
@@ -213,13 +219,13 @@ class Basso2012Detector:
         # Each cluster's voxels and full-resolution points (which inherit the label of
         # their voxel) as slices of one stable sort: the same rows, in the same order,
         # as boolean masks, without a pass over all points per cluster.
-        voxels_sorted = np.argsort(people, kind="stable")
+        voxels_sorted = stable_argsort(people + 1, k + 1)  # -1 (no cluster) first
         voxel_bounds = np.searchsorted(people[voxels_sorted], np.arange(k + 1))
         voxel_label = np.full(grid.centroids.shape[0], -1, dtype=np.int64)
         voxel_label[above] = people
         point_label = voxel_label[grid.point_voxel]
         labelled = np.flatnonzero(point_label >= 0)
-        order = np.argsort(point_label[labelled], kind="stable")
+        order = stable_argsort(point_label[labelled], k)
         full_sorted = labelled[order]
         full_bounds = np.searchsorted(point_label[full_sorted], np.arange(k + 1))
 

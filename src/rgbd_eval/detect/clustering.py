@@ -33,6 +33,7 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from rgbd_eval.detect.cloud import stable_argsort
+from rgbd_eval.detect.plane import cross3
 
 FloatArray = NDArray[np.float64]
 IntArray = NDArray[np.int64]
@@ -79,7 +80,7 @@ def connected_components(pairs: IntArray, n: int) -> IntArray:
     while True:
         li, lj = label[i], label[j]
         joining = li != lj
-        if not np.any(joining):
+        if not joining.any():
             return label
         i, j, li, lj = i[joining], j[joining], li[joining], lj[joining]
         label[np.maximum(li, lj)] = np.minimum(li, lj)
@@ -93,7 +94,7 @@ def connected_components(pairs: IntArray, n: int) -> IntArray:
 def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> IntArray:
     """Drop labels with too few/many points; renumber the rest by first occurrence."""
     valid = labels >= 0
-    if not np.any(valid):
+    if not valid.any():
         return np.full(labels.shape, -1, dtype=np.int64)
     lab = labels[valid]
     k = int(lab.max()) + 1
@@ -120,7 +121,7 @@ def group_extrema(groups: IntArray, values: FloatArray, k: int) -> tuple[FloatAr
     counts = np.bincount(groups, minlength=k)
     present = counts > 0
     starts = (np.cumsum(counts) - counts)[present]  # each present group's first sorted row
-    ordered = values[np.argsort(groups)]
+    ordered = values[stable_argsort(groups, k)]
     lo = np.full((k, *values.shape[1:]), np.inf)
     hi = np.full((k, *values.shape[1:]), -np.inf)
     if starts.shape[0]:
@@ -138,9 +139,9 @@ def ground_basis(normal: FloatArray) -> FloatArray:
     """Two orthonormal vectors ``(2, 3)`` spanning the plane with the given normal."""
     n = normal / float(np.linalg.norm(normal))
     helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    e1 = np.cross(n, helper)
+    e1 = cross3(n, helper)
     e1 /= float(np.linalg.norm(e1))
-    e2 = np.cross(n, e1)
+    e2 = cross3(n, e1)
     return np.stack([e1, e2])
 
 
@@ -207,7 +208,7 @@ def _height_map(
     low_max = group_extrema(flat[~high], heights[~high], size)[1]
     hmap = np.maximum(low_max, 0.0).reshape(shape)  # empty cells 0
     overhang = np.zeros(heights.shape, dtype=bool)
-    if np.any(high):
+    if high.any():
         lowest_high, top_high = (
             a.reshape(shape) for a in group_extrema(flat[high], heights[high], size)
         )
@@ -257,13 +258,13 @@ def _head_seeds(
         regions = _components8(window >= hmap[i, j] - min_head_prominence)
         mine = regions == regions[i - i0, j - j0]
         taken = seeds[i0 : i + half + 1, j0 : j + half + 1]
-        if np.any(mine & ((taken > 0) | (window > highest))):
+        if (mine & ((taken > 0) | (window > highest))).any():
             continue
         accepted.append((i, j))
         taken[mine] = len(accepted)
         ri, rj = np.nonzero(mine)
         centres.append(np.array([ri.mean() + i0, rj.mean() + j0]))
-    if np.any(tall):
+    if tall.any():
         tall_regions, _ = ndimage.label(tall, structure=np.ones((3, 3), dtype=bool))
         seeds[tall] = tall_regions[tall] + len(accepted)
     return seeds, centres
@@ -333,7 +334,7 @@ def split_by_heads(
     out = np.full(labels.shape, -1, dtype=np.int64)
     next_label = 0
     k = int(labels.max()) + 1 if labels.size else 0
-    members_sorted = np.argsort(labels, kind="stable")
+    members_sorted = stable_argsort(labels + 1, k + 1)  # -1 (no cluster) first
     bounds = np.searchsorted(labels[members_sorted], np.arange(k + 1))
     for c in range(k):
         members = members_sorted[bounds[c] : bounds[c + 1]]
@@ -369,4 +370,4 @@ def _may_hold_heads(heights: FloatArray, head_heights: tuple[float, float]) -> b
     its points is; otherwise (lower bound <= 0, where empty cells count) assume yes.
     """
     lowest, highest = head_heights
-    return lowest <= 0.0 or bool(np.any((heights >= lowest) & (heights <= highest)))
+    return lowest <= 0.0 or bool(((heights >= lowest) & (heights <= highest)).any())
