@@ -26,6 +26,7 @@ from rgbd_eval.detect.clustering import (
     connected_components,
     euclidean_clusters,
     filter_cluster_sizes,
+    find_heads,
     group_extrema,
     merge_close_clusters,
     split_by_heads,
@@ -377,6 +378,12 @@ def test_subclustering_matches_reference(seed: int, head_heights: tuple[float, f
     got = split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
     want = reference_split_by_heads(xy, h, merged, 0.06, 0.3, 0.1, head_heights)
     assert np.array_equal(got, want)
+    for c in range(int(merged.max()) + 1):  # the head positions of every cluster
+        mine = merged == c
+        hmap, _, origin, _ = reference_height_map(xy[mine], h[mine], 0.06, head_heights[1])
+        _, centres = reference_head_seeds(hmap, 0.06, 0.3, 0.1, head_heights)
+        heads = origin + (np.asarray(centres).reshape(-1, 2) - 1 + 0.5) * 0.06
+        assert np.array_equal(find_heads(xy[mine], h[mine], 0.06, 0.3, 0.1, head_heights), heads)
 
 
 @settings(max_examples=150, deadline=None)
