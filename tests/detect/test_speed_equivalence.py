@@ -18,7 +18,7 @@ from scipy.sparse import coo_matrix, csgraph
 from scipy.spatial import cKDTree
 
 from rgbd_eval.detect import clustering
-from rgbd_eval.detect.cloud import VoxelGrid, voxel_grid
+from rgbd_eval.detect.cloud import PointCloud, VoxelGrid, depth_to_cloud, voxel_grid
 from rgbd_eval.detect.clustering import (
     HEAD_SEARCH_RADIUS,
     OVERHANG_GAP,
@@ -220,6 +220,18 @@ def reference_split_by_heads(
         out[members] = np.where(overhang, -1, next_label + sub)
         next_label += n_seeds
     return reference_keep_sizes(out, 1, None)
+
+
+def reference_depth_to_cloud(
+    depth: NDArray[np.floating], rays: FloatArray, max_depth: float
+) -> PointCloud:
+    """Back-project a depth image with precomputed unit-depth ``rays`` (``(H, W, 3)``)."""
+    flat = depth.reshape(-1)
+    valid = np.isfinite(flat) & (flat > 0.0) & (flat <= max_depth)
+    pixels = np.flatnonzero(valid).astype(np.int64)
+    z = flat[pixels].astype(np.float64)
+    points = rays.reshape(-1, 3)[pixels] * z[:, None]
+    return PointCloud(points=points, pixels=pixels)
 
 
 def reference_voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
@@ -452,3 +464,16 @@ def test_clusters_and_size_filter_match_reference(
         filter_cluster_sizes(labels, min_points, max_points),
         reference_keep_sizes(labels, min_points, max_points),
     )
+
+
+@settings(max_examples=100, deadline=None)
+@given(SEEDS, st.sampled_from([np.float32, np.float64]))
+def test_depth_to_cloud_matches_reference(seed: int, dtype: type) -> None:
+    rng = np.random.default_rng(seed)
+    depth = rng.uniform(-1.0, 8.0, (12, 16)).astype(dtype)
+    specials = [np.nan, np.inf, -np.inf, 0.0, 6.5]  # invalid, and the limit itself
+    depth.reshape(-1)[rng.integers(0, depth.size, 40)] = rng.choice(specials, 40)
+    rays = CameraModel(16, 12, 10.0, 10.0, 7.5, 5.5).rays()
+    got, want = depth_to_cloud(depth, rays, 6.5), reference_depth_to_cloud(depth, rays, 6.5)
+    assert np.array_equal(got.pixels, want.pixels)
+    assert np.array_equal(got.points, want.points)

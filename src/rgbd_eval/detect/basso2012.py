@@ -171,7 +171,8 @@ class Basso2012Detector:
         cfg = self.config
         heights_all = signed_heights(grid.centroids, plane)
         above = np.flatnonzero(heights_all > cfg.voxel_size)  # ground band: one voxel (5.4.2)
-        pts, heights = grid.centroids[above], heights_all[above]
+        # np.take: the rows of ``a[index]``, several times faster on (N, 3) arrays.
+        pts, heights = np.take(grid.centroids, above, axis=0), heights_all[above]
         # Every connected piece is kept until merged: a head cut from its body by an
         # occluder is a small piece, rejoined by the merge (Munaro et al. 2012).
         pieces = euclidean_clusters(pts, cfg.cluster_tolerance_voxels * cfg.voxel_size, 1)
@@ -215,7 +216,7 @@ class Basso2012Detector:
         k = int(people.max()) + 1 if people.size else 0
         if k == 0:
             return []
-        pts = grid.centroids[above]
+        pts = np.take(grid.centroids, above, axis=0)
         # Each cluster's voxels and full-resolution points (which inherit the label of
         # their voxel) as slices of one stable sort: the same rows, in the same order,
         # as boolean masks, without a pass over all points per cluster.
@@ -240,19 +241,19 @@ class Basso2012Detector:
         ranges = np.linalg.norm(pts, axis=1)
         # Points of the (size-filtered) Euclidean clusters: the possible occluders.
         near = np.flatnonzero(clusters >= 0)
-        near_uv, near_range, near_label = uv[near], ranges[near], people[near]
+        near_uv, near_range, near_label = np.take(uv, near, axis=0), ranges[near], people[near]
         margin = cfg.cluster_tolerance_voxels * cfg.voxel_size
         footprint = _footprint(frame)
 
         # The height filter first (5.4.2), on each cluster's highest full-resolution point.
         tops = group_extrema(
-            point_label[labelled], signed_heights(cloud.points[labelled], plane), k
+            point_label[labelled], signed_heights(np.take(cloud.points, labelled, axis=0), plane), k
         )[1]
         in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
         geometries = {
             c: cluster_geometry(
                 pts[voxels(c)],
-                cloud.points[members(c)],
+                np.take(cloud.points, members(c), axis=0),
                 plane,
                 cfg.head_centroid,
                 cfg.surface_correction,
@@ -265,7 +266,7 @@ class Basso2012Detector:
             if not (cfg.min_height <= g.height <= cfg.max_height) or g.distance > cfg.max_distance:
                 continue
             mine = voxels(c)
-            box = full_body_box(g, uv[mine], project)
+            box = full_body_box(g, np.take(uv, mine, axis=0), project)
             if box is None:
                 continue
             cut_top, cut_bottom, cut_side = _touches_border(
@@ -276,7 +277,11 @@ class Basso2012Detector:
             )
             others = near_label != c
             occluded = (not in_view) or occluded_by_nearer_points(
-                box, float(ranges[mine].min()), near_uv[others], near_range[others], margin
+                box,
+                float(ranges[mine].min()),
+                np.compress(others, near_uv, axis=0),
+                near_range[others],
+                margin,
             )
             centre_u = box.left + 0.5 * box.width
             hog_eligible = (
@@ -286,11 +291,11 @@ class Basso2012Detector:
                 and box.bottom <= frame.rgb_camera.height - 0.5
                 and 0.0 <= centre_u < frame.rgb_camera.width
             )
-            blob_uv, _ = project(cloud.points[members(c)])
+            blob_uv, _ = project(np.take(cloud.points, members(c), axis=0))
             appearance = colour_histogram(
                 frame.rgb, blob(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
             )
-            box3d = _world_box(frame, np.vstack([pts[mine], g.ground_point[None, :]]))
+            box3d = _world_box(frame, np.vstack([np.take(pts, mine, axis=0), g.ground_point]))
             candidates.append(
                 (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, appearance))
             )

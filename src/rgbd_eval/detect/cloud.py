@@ -47,10 +47,12 @@ def depth_to_cloud(depth: NDArray[np.floating], rays: FloatArray, max_depth: flo
     if rays.shape[:2] != depth.shape:
         raise ValueError(f"rays {rays.shape[:2]} do not match depth image {depth.shape}")
     flat = depth.reshape(-1)
-    valid = np.isfinite(flat) & (flat > 0.0) & (flat <= max_depth)
-    pixels = np.flatnonzero(valid).astype(np.int64)
+    valid = (flat > 0.0) & (flat <= max_depth)  # NaN fails both
+    pixels = np.flatnonzero(valid).astype(np.int64, copy=False)
     z = flat[pixels].astype(np.float64)
-    points = rays.reshape(-1, 3)[pixels] * z[:, None]
+    # np.take: the rows of ``rays[pixels]``, several times faster on (N, 3) arrays.
+    points = np.take(rays.reshape(-1, 3), pixels, axis=0)
+    points *= z[:, None]
     return PointCloud(points=points, pixels=pixels)
 
 

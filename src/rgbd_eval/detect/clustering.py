@@ -122,7 +122,7 @@ def group_extrema(groups: IntArray, values: FloatArray, k: int) -> tuple[FloatAr
     counts = np.bincount(groups, minlength=k)
     present = counts > 0
     starts = (np.cumsum(counts) - counts)[present]  # each present group's first sorted row
-    ordered = values[stable_argsort(groups, k)]
+    ordered = np.take(values, stable_argsort(groups, k), axis=0)
     lo = np.full((k, *values.shape[1:]), np.inf)
     hi = np.full((k, *values.shape[1:]), -np.inf)
     if starts.shape[0]:
@@ -166,7 +166,7 @@ def merge_close_clusters(
         return labels
     valid = labels >= 0
     lab = labels[valid]
-    xy = ground_xy[valid]
+    xy = np.compress(valid, ground_xy, axis=0)  # ground_xy[valid], faster
     counts = np.bincount(lab, minlength=k).astype(np.float64)
     centres = (
         np.stack([np.bincount(lab, weights=xy[:, j], minlength=k) for j in (0, 1)], axis=1)
@@ -347,7 +347,7 @@ def split_by_heads(
             next_label += 1
             continue
         hmap, ij, _, overhang = _height_map(
-            ground_xy[members], heights[members], cell, head_heights[1]
+            np.take(ground_xy, members, axis=0), heights[members], cell, head_heights[1]
         )
         seeds, heads = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
         n_seeds = int(seeds.max())

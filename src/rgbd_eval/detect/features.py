@@ -68,7 +68,7 @@ def cluster_geometry(
     voxel_heights = voxel_points @ normal + d
     height = float(heights.max())
     if head_centroid:
-        head = points[heights >= height * (1.0 - HEAD_FRACTION)]
+        head = np.compress(heights >= height * (1.0 - HEAD_FRACTION), points, axis=0)
         centroid = head.mean(axis=0)
         if surface_correction:
             centroid = centroid + _surface_to_axis(head, centroid, normal)
