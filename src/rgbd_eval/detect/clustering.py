@@ -102,9 +102,9 @@ def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> In
     keep = counts >= max(min_points, 1)  # labels that do not occur are never kept
     if max_points is not None:
         keep &= counts <= max_points
-    # Each kept label's first occurrence: the first of its run in a stable sort.
-    first = stable_argsort(lab, k)[(np.cumsum(counts) - counts)[keep]]
-    kept = np.flatnonzero(keep)[np.argsort(first)]
+    first = np.full(k, lab.shape[0])  # each label's first occurrence
+    np.minimum.at(first, lab, np.arange(lab.shape[0]))
+    kept = np.flatnonzero(keep)[np.argsort(first[keep])]
     lookup = np.full(k, -1, dtype=np.int64)
     lookup[kept] = np.arange(kept.shape[0], dtype=np.int64)
     out = np.full(labels.shape, -1, dtype=np.int64)
