@@ -18,7 +18,13 @@ from scipy.sparse import coo_matrix, csgraph
 from scipy.spatial import cKDTree
 
 from rgbd_eval.detect import clustering
-from rgbd_eval.detect.cloud import PointCloud, VoxelGrid, depth_to_cloud, voxel_grid
+from rgbd_eval.detect.cloud import (
+    PointCloud,
+    VoxelGrid,
+    depth_to_cloud,
+    stable_argsort,
+    voxel_grid,
+)
 from rgbd_eval.detect.clustering import (
     HEAD_SEARCH_RADIUS,
     OVERHANG_GAP,
@@ -477,3 +483,12 @@ def test_depth_to_cloud_matches_reference(seed: int, dtype: type) -> None:
     got, want = depth_to_cloud(depth, rays, 6.5), reference_depth_to_cloud(depth, rays, 6.5)
     assert np.array_equal(got.pixels, want.pixels)
     assert np.array_equal(got.points, want.points)
+
+
+@settings(max_examples=100, deadline=None)
+@given(SEEDS, st.integers(0, 3000), st.sampled_from([1, 7, 5000, 2**31, 2**40]))
+def test_stable_argsort_is_numpys(seed: int, n: int, key_count: int) -> None:
+    keys = np.random.default_rng(seed).integers(0, key_count, n)
+    for dtype in (np.int64, np.int32) if key_count <= 2**31 else (np.int64,):
+        k = keys.astype(dtype)
+        assert np.array_equal(stable_argsort(k, key_count), np.argsort(k, kind="stable"))

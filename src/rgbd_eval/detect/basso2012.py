@@ -252,7 +252,7 @@ class Basso2012Detector:
         in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
         geometries = {
             c: cluster_geometry(
-                pts[voxels(c)],
+                np.take(pts, voxels(c), axis=0),
                 np.take(cloud.points, members(c), axis=0),
                 plane,
                 cfg.head_centroid,

@@ -100,6 +100,6 @@ def stable_argsort(keys: IntArray, key_count: int) -> IntArray:
     n = keys.shape[0]
     if key_count > 2**31 or n > 2**32:
         return np.argsort(keys, kind="stable")
-    packed = np.sort((keys << 32) | np.arange(n, dtype=np.int64))
+    packed = np.sort((keys.astype(np.int64, copy=False) << 32) | np.arange(n, dtype=np.int64))
     order: IntArray = packed & 0xFFFFFFFF
     return order

@@ -216,7 +216,7 @@ def blob(uv: FloatArray, footprint: int, rgb_camera: CameraModel) -> Blob:
     return Blob(top, left, mask[:height, :width])
 
 
-def colour_histogram(rgb: NDArray[np.uint8], pixels: Blob, bins: int) -> NDArray[np.float32]:
+def colour_histogram(rgb: NDArray[np.uint8], region: Blob, bins: int) -> NDArray[np.float32]:
     """Flattened 3D RGB histogram (``bins**3`` values, R slowest) normalised to sum 1 (6.2.2).
 
     Channel value ``x`` falls in bin ``x * bins // 256``. An empty blob gives the
@@ -225,12 +225,12 @@ def colour_histogram(rgb: NDArray[np.uint8], pixels: Blob, bins: int) -> NDArray
     if bins < 1:
         raise ValueError(f"bins must be >= 1, got {bins}")
     size = bins**3
-    if not np.any(pixels.mask):
+    if not region.mask.any():
         return np.full(size, 1.0 / size, dtype=np.float32)
-    height, width = pixels.mask.shape
-    crop = rgb[pixels.top : pixels.top + height, pixels.left : pixels.left + width]
+    height, width = region.mask.shape
+    crop = rgb[region.top : region.top + height, region.left : region.left + width]
     # OpenCV counts exactly (integers, returned as float32) with these bins.
-    counts = cv2.calcHist([crop], [0, 1, 2], pixels.mask.view(np.uint8), [bins] * 3, [0, 256] * 3)
+    counts = cv2.calcHist([crop], [0, 1, 2], region.mask.view(np.uint8), [bins] * 3, [0, 256] * 3)
     hist = np.asarray(counts, dtype=np.float64).reshape(-1)
     out: NDArray[np.float32] = (hist / hist.sum()).astype(np.float32)
     return out
