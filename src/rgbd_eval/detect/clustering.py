@@ -200,7 +200,7 @@ def _height_map(
     people, seen from below). A wall continues down, so it stays in the map,
     taller than any person.
     """
-    origin = ground_xy.min(axis=0)
+    origin = np.array([ground_xy[:, 0].min(), ground_xy[:, 1].min()])  # faster than axis=0
     ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1
     shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
     # ``ufunc.at`` is fast with a flat index, slow with a tuple of row and column indices.
