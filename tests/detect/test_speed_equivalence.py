@@ -1,10 +1,10 @@
 """The vectorised detector code gives the same results as the straightforward one.
 
 The ``reference_*`` functions below are the implementations before the speed-up
-(``np.maximum.at`` height maps, ``ndimage`` filters and labelling, one cluster
-at a time; blob masks over the whole image), kept verbatim but for their
-docstrings. The tests drive both with
-random clouds and compare the outputs exactly.
+(``np.unique`` voxels and size filters, ``scipy.sparse.csgraph`` components,
+``np.maximum.at`` height maps, ``ndimage`` peak filter and labelling, blob
+masks over the whole image), kept verbatim but for their docstrings. The tests
+drive both with random inputs and compare the outputs exactly.
 """
 
 from __future__ import annotations
