@@ -14,7 +14,8 @@ from rgbd_eval.detect.clustering import (
 )
 from rgbd_eval.detect.features import (
     HEAD_FRACTION,
-    blob_pixels,
+    Blob,
+    blob,
     cluster_geometry,
     colour_histogram,
     occluded_by_nearer_points,
@@ -173,25 +174,27 @@ def test_colour_histogram_counts_blob_pixels() -> None:
     rgb[0, 0] = (255, 0, 0)  # bins (1, 0, 0) with 2 bins per channel -> index 4
     rgb[0, 1] = (255, 0, 0)
     rgb[1, 0] = (0, 0, 200)  # bins (0, 0, 1) -> index 1
-    hist = colour_histogram(rgb, np.array([0, 1, 2]), 2)
+    three = Blob(0, 0, np.array([[True, True], [True, False]]))
+    hist = colour_histogram(rgb, three, 2)
     assert hist.dtype == np.float32 and hist.shape == (8,)
     # 2 of 3 pixels in bin 4, 1 of 3 in bin 1.
     np.testing.assert_allclose(hist, [0, 1 / 3, 0, 0, 2 / 3, 0, 0, 0], atol=1e-7)
-    empty = colour_histogram(rgb, np.zeros(0, dtype=np.int64), 2)
+    # The box is placed on the image: only pixel (1, 0) in a 1x1 box.
+    np.testing.assert_allclose(colour_histogram(rgb, Blob(1, 0, np.ones((1, 1), bool)), 2)[1], 1)
+    empty = colour_histogram(rgb, Blob(0, 0, np.zeros((0, 0), dtype=bool)), 2)
     np.testing.assert_allclose(empty, np.full(8, 1 / 8))
 
 
-def test_blob_pixels_cover_each_points_footprint() -> None:
+def test_blob_covers_each_points_footprint() -> None:
     cam = CameraModel(10, 10, 5.0, 5.0, 4.5, 4.5)
-    # One point at (2, 3) with a 2x2 footprint: offsets -0.5, +0.5 -> u in {2, 3}
-    # (np.rint rounds 1.5 to 2 and 2.5 to 2): pixels (2..3?, ...). Check the count
-    # and that they are around (2, 3); a point off the image adds nothing.
-    px = blob_pixels(np.array([[2.0, 3.0], [50.0, 50.0]]), 3, cam)
-    rows, cols = np.divmod(px, 10)
+    # A point off the image adds nothing.
+    b = blob(np.array([[2.0, 3.0], [50.0, 50.0]]), 3, cam)
     # Footprint 3: offsets -1, 0, 1 -> a 3x3 block centred on (u=2, v=3).
-    assert sorted(set(cols.tolist())) == [1, 2, 3]
-    assert sorted(set(rows.tolist())) == [2, 3, 4]
-    assert px.shape[0] == 9
+    rows, cols = np.nonzero(b.mask)
+    assert sorted(set((rows + b.top).tolist())) == [2, 3, 4]
+    assert sorted(set((cols + b.left).tolist())) == [1, 2, 3]
+    assert rows.shape[0] == 9
+    assert not blob(np.array([[50.0, 50.0]]), 3, cam).mask.any()
 
 
 def test_person_next_to_a_wall_is_split_from_it() -> None:

@@ -8,9 +8,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval.detect.plane import cross3
 from rgbd_eval.types import Box2D, CameraModel, Pose
 
 FloatArray = NDArray[np.float64]
@@ -66,7 +68,7 @@ def cluster_geometry(
     voxel_heights = voxel_points @ normal + d
     height = float(heights.max())
     if head_centroid:
-        head = points[heights >= height * (1.0 - HEAD_FRACTION)]
+        head = np.compress(heights >= height * (1.0 - HEAD_FRACTION), points, axis=0)
         centroid = head.mean(axis=0)
         if surface_correction:
             centroid = centroid + _surface_to_axis(head, centroid, normal)
@@ -93,35 +95,45 @@ def _surface_to_axis(part: FloatArray, centroid: FloatArray, normal: FloatArray)
     if norm < 1e-9 or part.shape[0] < 2:
         return np.zeros(3)
     view /= norm
-    across = np.cross(normal, view)
+    across = cross3(normal, view)
     spread = float(np.std(part @ across))
     shift: FloatArray = view * (SURFACE_TO_AXIS * spread)
     return shift
+
+
+class RgbProjection:
+    """Depth-optical points -> RGB pixels for one frame, the rotation matrix computed once.
+
+    Calling it gives the pixel coordinates ``(N, 2)`` and the RGB-frame depth ``(N,)``.
+    """
+
+    def __init__(self, depth_to_rgb: Pose, rgb_camera: CameraModel) -> None:
+        # The arithmetic of ``Pose.transform_points``, with its matrix kept.
+        self._rotation_t = depth_to_rgb.rotation_matrix().T
+        self._translation = np.asarray(depth_to_rgb.translation)
+        self.camera = rgb_camera
+
+    def __call__(self, points: FloatArray) -> tuple[FloatArray, FloatArray]:
+        in_rgb = np.asarray(points, dtype=np.float64) @ self._rotation_t + self._translation
+        return self.camera.project(in_rgb), in_rgb[:, 2]
 
 
 def project_to_rgb(
     points: FloatArray, depth_to_rgb: Pose, rgb_camera: CameraModel
 ) -> tuple[FloatArray, FloatArray]:
     """Depth-optical points -> RGB pixel coordinates ``(N, 2)`` and their RGB-frame depth ``(N,)``."""
-    in_rgb = depth_to_rgb.transform_points(points)
-    uv = rgb_camera.project(in_rgb)
-    return uv, in_rgb[:, 2]
+    return RgbProjection(depth_to_rgb, rgb_camera)(points)
 
 
 def full_body_box(
-    geometry: ClusterGeometry,
-    cluster_uv: FloatArray,
-    depth_to_rgb: Pose,
-    rgb_camera: CameraModel,
+    geometry: ClusterGeometry, cluster_uv: FloatArray, project: RgbProjection
 ) -> Box2D | None:
     """The theoretical box on the RGB image: head to ground vertically (5.3).
 
     Horizontally it spans the cluster's projected points. None when the head or
     the ground point is behind the RGB camera.
     """
-    ends, z = project_to_rgb(
-        np.stack([geometry.top_point, geometry.ground_point]), depth_to_rgb, rgb_camera
-    )
+    ends, z = project(np.stack([geometry.top_point, geometry.ground_point]))
     if np.any(z <= 1e-3):
         return None
     top = float(ends[:, 1].min())
@@ -167,39 +179,58 @@ def occluded_by_nearer_points(
     return bool(np.any(inside))
 
 
-def blob_pixels(uv: FloatArray, footprint: int, rgb_camera: CameraModel) -> IntArray:
-    """Flat RGB-image indices of the blob: each projected point covers ``footprint^2`` pixels.
+@dataclass(frozen=True, eq=False)
+class Blob:
+    """The RGB pixels of a cluster: ``mask`` over the box whose top-left pixel is ``(top, left)``."""
+
+    top: int
+    left: int
+    mask: NDArray[np.bool_]
+
+
+def blob(uv: FloatArray, footprint: int, rgb_camera: CameraModel) -> Blob:
+    """The blob on the RGB image: each projected point covers ``footprint^2`` pixels.
 
     A depth pixel seen from the RGB camera covers about ``fx_rgb / fx_depth``
     RGB pixels per side, so a decimated depth image still yields a solid mask.
+    Pixel ``j`` of the ``k`` a point covers per side is ``rint(u + j - (k - 1) / 2)``.
     """
+    empty = Blob(0, 0, np.zeros((0, 0), dtype=bool))
     if uv.shape[0] == 0:
-        return np.zeros(0, dtype=np.int64)
+        return empty
     k = max(1, int(footprint))
     offsets = np.arange(k, dtype=np.float64) - (k - 1) / 2.0
-    du, dv = np.meshgrid(offsets, offsets)
-    u = np.rint(uv[:, 0:1] + du.reshape(1, -1)).astype(np.int64).reshape(-1)
-    v = np.rint(uv[:, 1:2] + dv.reshape(1, -1)).astype(np.int64).reshape(-1)
-    ok = (u >= 0) & (u < rgb_camera.width) & (v >= 0) & (v < rgb_camera.height)
-    mask = np.zeros(rgb_camera.width * rgb_camera.height, dtype=bool)
-    mask[v[ok] * rgb_camera.width + u[ok]] = True
-    pixels: IntArray = np.flatnonzero(mask).astype(np.int64)
-    return pixels
+    # Each point's k columns and k rows; its pixels are all their pairs.
+    u = np.rint(uv[:, 0:1] + offsets).astype(np.int64)
+    v = np.rint(uv[:, 1:2] + offsets).astype(np.int64)
+    left, right = max(int(u.min()), 0), min(int(u.max()), rgb_camera.width - 1)
+    top, bottom = max(int(v.min()), 0), min(int(v.max()), rgb_camera.height - 1)
+    if left > right or top > bottom:
+        return empty
+    height, width = bottom - top + 1, right - left + 1
+    # Columns and rows off the image go to a spare last column and row of the mask.
+    cols = np.where((u >= 0) & (u < rgb_camera.width), u - left, width)
+    rows = np.where((v >= 0) & (v < rgb_camera.height), v - top, height)
+    mask = np.zeros((height + 1, width + 1), dtype=bool)
+    mask.reshape(-1)[rows[:, :, None] * (width + 1) + cols[:, None, :]] = True
+    return Blob(top, left, mask[:height, :width])
 
 
-def colour_histogram(rgb: NDArray[np.uint8], pixels: IntArray, bins: int) -> NDArray[np.float32]:
+def colour_histogram(rgb: NDArray[np.uint8], region: Blob, bins: int) -> NDArray[np.float32]:
     """Flattened 3D RGB histogram (``bins**3`` values, R slowest) normalised to sum 1 (6.2.2).
 
-    An empty blob gives the uniform histogram.
+    Channel value ``x`` falls in bin ``x * bins // 256``. An empty blob gives the
+    uniform histogram.
     """
     if bins < 1:
         raise ValueError(f"bins must be >= 1, got {bins}")
     size = bins**3
-    if pixels.shape[0] == 0:
+    if not region.mask.any():
         return np.full(size, 1.0 / size, dtype=np.float32)
-    flat = rgb.reshape(-1, rgb.shape[-1])
-    lut = np.arange(256, dtype=np.intp) * bins // 256  # channel value -> bin
-    index = (lut[flat[pixels, 0]] * bins + lut[flat[pixels, 1]]) * bins + lut[flat[pixels, 2]]
-    hist = np.bincount(index, minlength=size).astype(np.float64)
+    height, width = region.mask.shape
+    crop = rgb[region.top : region.top + height, region.left : region.left + width]
+    # OpenCV counts exactly (integers, returned as float32) with these bins.
+    counts = cv2.calcHist([crop], [0, 1, 2], region.mask.view(np.uint8), [bins] * 3, [0, 256] * 3)
+    hist = np.asarray(counts, dtype=np.float64).reshape(-1)
     out: NDArray[np.float32] = (hist / hist.sum()).astype(np.float32)
     return out

@@ -92,7 +92,7 @@ def refine_plane(
         count = int(inliers.sum())
         if count < min_points:
             return current, count
-        current = fit_plane_least_squares(points[inliers])
+        current = fit_plane_least_squares(np.compress(inliers, points, axis=0))
     return current, count
 
 

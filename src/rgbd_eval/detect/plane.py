@@ -43,6 +43,13 @@ def signed_heights(points: FloatArray, plane: FloatArray) -> FloatArray:
     return heights
 
 
+def cross3(a: FloatArray, b: FloatArray) -> FloatArray:
+    """The cross product of two 3-vectors: ``np.cross``'s arithmetic without its overhead."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def fit_plane_least_squares(points: FloatArray) -> FloatArray:
     """Total-least-squares plane through ``(N >= 3, 3)`` points (smallest singular vector)."""
     if points.shape[0] < 3:
