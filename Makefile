@@ -35,8 +35,9 @@ datasets: $(STAMP)
 run: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval run $(DEMO)
 
-# One-core figures (the bench pins itself to one CPU): the demo, one thesis scenario,
-# and the demo with raw RGB in .mcap and .bag (decode floor for raw images). JSON under runs/bench/.
+# One-core figures (the bench pins itself to one CPU): the demo, one thesis scenario, the
+# demo with depth at 320x240, and with raw RGB in .mcap and .bag (decode floor for raw
+# images). JSON under runs/bench/.
 bench: $(STAMP) $(DEMO)
 	@mkdir -p runs/bench
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 3 --json > runs/bench/demo.json
@@ -44,6 +45,8 @@ bench: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval bench datasets/generated/moving_complex.mcap --repeat 1 --json > runs/bench/moving_complex.json
 	@test -f runs/bench/demo_raw.mcap || $(BIN)/rgbd-eval synth demo --set recording.rgb_format=raw -o runs/bench/demo_raw.mcap
 	@test -f runs/bench/demo_raw.bag || $(BIN)/rgbd-eval synth demo --set recording.rgb_format=raw -o runs/bench/demo_raw.bag
+	@test -f runs/bench/demo_320.mcap || $(BIN)/rgbd-eval synth demo --set sensor.depth_decimation=2 -o runs/bench/demo_320.mcap
+	$(BIN)/rgbd-eval bench runs/bench/demo_320.mcap --repeat 3 --json > runs/bench/demo_320.json
 	$(BIN)/rgbd-eval bench runs/bench/demo_raw.mcap --repeat 3 --json > runs/bench/demo_raw_mcap.json
 	$(BIN)/rgbd-eval bench runs/bench/demo_raw.bag --repeat 3 --json > runs/bench/demo_raw_bag.json
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
