@@ -1,9 +1,9 @@
-"""The vectorised detector code gives the same results as the straightforward one.
+"""The vectorised and compiled detector code gives the same results as the straightforward one.
 
 The ``reference_*`` functions below are the implementations before the speed-up
-(``np.unique`` voxels and size filters, ``scipy.sparse.csgraph`` components,
-``np.maximum.at`` height maps, ``ndimage`` peak filter and labelling, blob
-masks over the whole image), kept verbatim but for their docstrings. The tests
+(``np.unique`` voxels and size filters, ``cKDTree`` pairs and ``scipy.sparse.csgraph``
+components, ``np.maximum.at`` height maps, ``ndimage`` peak filter and labelling,
+blob masks over the whole image), kept verbatim but for their docstrings. The tests
 drive both with random inputs and compare the outputs exactly.
 """
 
@@ -470,6 +470,37 @@ def test_clusters_and_size_filter_match_reference(
         filter_cluster_sizes(labels, min_points, max_points),
         reference_keep_sizes(labels, min_points, max_points),
     )
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    SEEDS,
+    st.integers(1, 600),
+    st.sampled_from([0.12, 0.06 * 2.0, 0.1, 0.35, 1e-7]),
+    st.sampled_from([1e-3, 1.0, 100.0]),
+)
+def test_grid_clusters_match_kdtree_at_the_tolerance(
+    seed: int, n: int, tolerance: float, offset: float
+) -> None:
+    """Pairs at (or a few ulps around) exactly the tolerance are linked as by cKDTree."""
+    rng = np.random.default_rng(seed)
+    # Voxel-centroid-like points: a lattice of voxels (some of step ``tolerance``),
+    # jittered or not, far from the origin or not.
+    step = rng.choice([0.06, tolerance, tolerance / 2])
+    base = (
+        offset + step * rng.integers(0, 12, (n, 3)) + rng.choice([0.0, 1e-3]) * rng.random((n, 3))
+    )
+    # Partners displaced along one axis by the tolerance, nudged by -2..2 ulps.
+    axis = rng.integers(0, 3, n)
+    moved = base.copy()
+    moved[np.arange(n), axis] += tolerance
+    for _ in range(2):
+        nudge = rng.integers(-1, 2, (n, 1)) * (np.arange(3) == axis[:, None])
+        moved = np.where(nudge > 0, np.nextafter(moved, np.inf), moved)
+        moved = np.where(nudge < 0, np.nextafter(moved, -np.inf), moved)
+    points = np.concatenate([base, moved])[rng.permutation(2 * n)]
+    got = euclidean_clusters(points, tolerance, 1)
+    assert np.array_equal(got, reference_euclidean_clusters(points, tolerance, 1))
 
 
 @settings(max_examples=100, deadline=None)

@@ -24,9 +24,11 @@ Labels are integers per point, ``-1`` for "no cluster".
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
@@ -54,16 +56,125 @@ def euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) ->
 
     Components smaller than ``min_points`` get label -1. Labels are renumbered
     0..K-1 in order of each component's first point (deterministic).
+
+    The graph is that of ``cKDTree.query_pairs(tolerance)`` (p = 2): two points
+    are linked when their squared distance, summed over x, y, z in that order, is
+    ``<= tolerance * tolerance``, so points exactly ``tolerance`` apart are linked
+    as there. Candidate pairs come from a uniform grid of cells a hair wider than
+    ``tolerance`` (no rounding of the cell indices can then put two linked points
+    two cells apart), see :func:`_grid_components`.
     """
     if not tolerance > 0:
         raise ValueError(f"tolerance must be positive, got {tolerance}")
     n = points.shape[0]
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    # Unbalanced, non-compact trees build faster and query as fast here.
-    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
-    pairs = tree.query_pairs(tolerance, output_type="ndarray")
-    return _keep_sizes(connected_components(pairs, n), min_points, None)
+    columns = [points[:, d] for d in range(3)]  # column-wise: (N, 3).min(axis=0) is slow
+    lo = np.array([float(column.min()) for column in columns])
+    extent = max(float(column.max()) - low for column, low in zip(columns, lo, strict=True))
+    # Wider cells only cost distance tests; at most 2**20 cells per axis keep the
+    # cell keys below 2**63.
+    cell = max(tolerance * (1.0 + 1e-6), extent / 2.0**20)
+    idx = np.floor((points - lo) / cell).astype(np.int64) + 1  # >= 1: neighbours >= 0
+    ny, nz = int(idx[:, 1].max()) + 2, int(idx[:, 2].max()) + 2
+    # Cell keys in z-fastest order: a column's cells (dz = -1, 0, 1) have consecutive keys.
+    keys = (idx[:, 0] * ny + idx[:, 1]) * nz + idx[:, 2]
+    order = np.argsort(keys, kind="stable")
+    labels = _grid_components_kernel(
+        np.take(points, order, axis=0), keys[order], order, ny, nz, tolerance * tolerance
+    )
+    return _keep_sizes(labels, min_points, None)
+
+
+def _grid_components(
+    points: FloatArray, keys: IntArray, order: IntArray, ny: int, nz: int, r2: float
+) -> IntArray:
+    """Each point labelled with the smallest input index of its component.
+
+    ``points`` ``(N, 3)`` are sorted by cell, ``keys`` their cell keys
+    ``(ix * ny + iy) * nz + iz``, ``order`` their input indices; points are linked
+    when their squared distance is ``<= r2``.
+    """
+    n = points.shape[0]
+    # Cells: their keys and first positions (cell_start[n_cells] = n).
+    cell_start = np.empty(n + 1, dtype=np.int64)
+    n_cells = 0
+    for s in range(n):
+        if s == 0 or keys[s] != keys[s - 1]:
+            cell_start[n_cells] = s
+            n_cells += 1
+    cell_start[n_cells] = n
+    cell_keys = keys[cell_start[:n_cells]]
+    # Each pair once: a cell with itself and with the cell above it (dz = 1), and
+    # with the three cells (dz = -1..1) of each column ahead: (dx, dy) = (0, 1),
+    # (1, -1), (1, 0), (1, 1). Their keys grow with the cell's key, so each
+    # column ahead is found by a pointer moving forward through the sorted cells.
+    ahead = np.array([nz, (ny - 1) * nz, ny * nz, (ny + 1) * nz])
+    pointer = np.zeros(4, dtype=np.int64)
+    first = np.empty(5, dtype=np.int64)  # the position ranges to test against
+    last = np.empty(5, dtype=np.int64)
+    parent = np.arange(n)  # union-find over positions in cell order
+    for c in range(n_cells):
+        key = cell_keys[c]
+        above = c + 1 < n_cells and cell_keys[c + 1] == key + 1
+        last[0] = cell_start[c + 2] if above else cell_start[c + 1]
+        for col in range(4):
+            centre = key + ahead[col]
+            q = pointer[col]
+            while q < n_cells and cell_keys[q] < centre - 1:
+                q += 1
+            pointer[col] = q
+            r = q
+            while r < n_cells and cell_keys[r] <= centre + 1:
+                r += 1
+            first[col + 1], last[col + 1] = cell_start[q], cell_start[r]
+        for s in range(cell_start[c], cell_start[c + 1]):
+            first[0] = s + 1  # pairs within the cell once
+            for k in range(5):
+                for t in range(first[k], last[k]):
+                    e = points[s, 0] - points[t, 0]
+                    d2 = e * e
+                    e = points[s, 1] - points[t, 1]
+                    d2 += e * e
+                    e = points[s, 2] - points[t, 2]
+                    d2 += e * e
+                    if d2 <= r2:
+                        _union_kernel(parent, s, t)
+    # Back to the input order, each component named by its smallest input index.
+    smallest = np.full(n, n)
+    for s in range(n):
+        root = _find_kernel(parent, s)
+        smallest[root] = min(smallest[root], order[s])
+    labels = np.empty(n, dtype=np.int64)
+    for s in range(n):
+        labels[order[s]] = smallest[parent[s]]
+    return labels
+
+
+def _find(parent: IntArray, i: int) -> int:
+    """Root of ``i`` in the union-find forest, halving the path on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+def _union(parent: IntArray, i: int, j: int) -> None:
+    """Join the trees of ``i`` and ``j``: the larger root goes under the smaller."""
+    a, b = _find_kernel(parent, i), _find_kernel(parent, j)
+    if a < b:
+        parent[b] = a
+    elif b < a:
+        parent[a] = b
+
+
+#: Compiled on first use, cached on disk; no ``fastmath``: the distance test rounds
+#: operation by operation, as scipy's.
+_find_kernel: Callable[[IntArray, int], int] = numba.njit(cache=True)(_find)
+_union_kernel: Callable[[IntArray, int, int], None] = numba.njit(cache=True)(_union)
+_grid_components_kernel: Callable[[FloatArray, IntArray, IntArray, int, int, float], IntArray] = (
+    numba.njit(cache=True)(_grid_components)
+)
 
 
 def connected_components(pairs: IntArray, n: int) -> IntArray:
