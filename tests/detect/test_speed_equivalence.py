@@ -357,19 +357,40 @@ def test_group_extrema_match_ufunc_at(seed: int, k: int, n: int) -> None:
 
 @settings(max_examples=100, deadline=None)
 @given(SEEDS, st.integers(1, 25), st.integers(1, 25), st.integers(1, 4))
-def test_map_filter_and_labels_match_ndimage(seed: int, rows: int, cols: int, radius: int) -> None:
+def test_map_filter_matches_ndimage(seed: int, rows: int, cols: int, radius: int) -> None:
     rng = np.random.default_rng(seed)
     image = np.where(rng.random((rows, cols)) < 0.3, 0.0, rng.normal(1.0, 1.0, (rows, cols)))
     yy, xx = np.mgrid[-radius : radius + 1, -radius : radius + 1]
     disk = yy * yy + xx * xx <= radius * radius
     want = ndimage.maximum_filter(image, footprint=disk, mode="constant")
     assert np.array_equal(clustering._maximum_filter(image, radius), want)
-    mask = image > 0.8
-    ours = clustering._components8(mask)
-    theirs, _ = ndimage.label(mask, structure=np.ones((3, 3), dtype=bool))
-    # The same partition: a one-to-one map between the two labellings.
-    pairs = np.unique(np.stack([ours.ravel(), theirs.ravel()]), axis=1)
-    assert np.unique(pairs[0]).size == np.unique(pairs[1]).size == pairs.shape[1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    SEEDS,
+    st.integers(1, 45),
+    st.integers(1, 45),
+    st.sampled_from([0.0, 0.1, 0.3]),
+    st.sampled_from([(1.4, 2.3), (0.0, np.inf), (-1.0, 2.0)]),
+)
+def test_head_seeds_match_reference(
+    seed: int, rows: int, cols: int, prominence: float, head_heights: tuple[float, float]
+) -> None:
+    rng = np.random.default_rng(seed)
+    # Bumps of person-like heights in 2 cm steps (plateaus, ties), some cells empty.
+    yy, xx = np.mgrid[0:rows, 0:cols]
+    hmap = np.zeros((rows, cols))
+    for _ in range(rng.integers(0, 6)):
+        ci, cj, width = rng.uniform(0, rows), rng.uniform(0, cols), rng.uniform(1.0, 6.0)
+        bump = rng.uniform(1.0, 2.6) * np.exp(-((yy - ci) ** 2 + (xx - cj) ** 2) / width**2)
+        hmap = np.maximum(hmap, bump)
+    hmap = np.round((hmap + rng.uniform(0, 0.3, hmap.shape)) / 0.02) * 0.02
+    hmap[rng.random(hmap.shape) < 0.1] = 0.0
+    seeds, centres = clustering._head_seeds(hmap, 0.06, 0.3, prominence, head_heights)
+    want_seeds, want_centres = reference_head_seeds(hmap, 0.06, 0.3, prominence, head_heights)
+    assert np.array_equal(seeds, want_seeds)
+    assert np.array_equal(centres, np.asarray(want_centres, dtype=np.float64).reshape(-1, 2))
 
 
 @settings(max_examples=150, deadline=None)

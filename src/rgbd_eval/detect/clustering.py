@@ -341,7 +341,7 @@ def _head_seeds(
     min_head_distance: float,
     min_head_prominence: float,
     head_heights: tuple[float, float],
-) -> tuple[IntArray, list[FloatArray]]:
+) -> tuple[IntArray, FloatArray]:
     """Seed regions of the map (0 = none): the heads first (1..H), then tall structures.
 
     Returns the seed map and the head-region centres (cell coordinates), highest first.
@@ -359,30 +359,98 @@ def _head_seeds(
     # a second peak closer than ``min_head_distance``, which is dropped anyway.
     half = max(1, int(np.ceil(HEAD_SEARCH_RADIUS / cell)))
     min_cells2 = (min_head_distance / cell) ** 2
-    accepted: list[tuple[int, int]] = []
-    centres: list[FloatArray] = []
-    for i, j in zip(pi[order].tolist(), pj[order].tolist(), strict=True):
-        if any((i - a) ** 2 + (j - b) ** 2 < min_cells2 for a, b in accepted):
-            continue
-        # The head's region: cells reachable from the peak without descending by the
-        # prominence. Another head or a taller structure inside it makes this peak
-        # part of that (followed within HEAD_SEARCH_RADIUS of the peak).
-        i0, j0 = max(0, i - half), max(0, j - half)
-        window = hmap[i0 : i + half + 1, j0 : j + half + 1]
-        regions = _components8(window >= hmap[i, j] - min_head_prominence)
-        mine = regions == regions[i - i0, j - j0]
-        taken = seeds[i0 : i + half + 1, j0 : j + half + 1]
-        if (mine & ((taken > 0) | (window > highest))).any():
-            continue
-        accepted.append((i, j))
-        taken[mine] = len(accepted)
-        ri, rj = np.nonzero(mine)
-        # Means of small integers, exact sums: ``ri.mean()`` without its overhead.
-        centres.append(np.array([ri.sum() / ri.size + i0, rj.sum() / rj.size + j0]))
+    centres = np.empty((order.shape[0], 2))
+    accepted = _grow_heads_kernel(
+        hmap,
+        pi[order],
+        pj[order],
+        half,
+        min_cells2,
+        float(min_head_prominence),
+        float(highest),
+        seeds,
+        centres,
+    )
     if tall.any():
         tall_regions, _ = ndimage.label(tall, structure=np.ones((3, 3), dtype=bool))
-        seeds[tall] = tall_regions[tall] + len(accepted)
-    return seeds, centres
+        seeds[tall] = tall_regions[tall] + accepted
+    return seeds, centres[:accepted]
+
+
+def _grow_heads(
+    hmap: FloatArray,
+    peak_i: IntArray,
+    peak_j: IntArray,
+    half: int,
+    min_cells2: float,
+    prominence: float,
+    highest: float,
+    seeds: IntArray,
+    centres: FloatArray,
+) -> int:
+    """Accept the candidate peaks as heads in turn, growing their regions in ``seeds``.
+
+    A peak is dropped when closer than ``sqrt(min_cells2)`` cells to an accepted
+    head, or when its region (the cells 8-connected to it at or above its height
+    minus ``prominence``, within ``half`` cells of it) holds another head's cell
+    or a cell above ``highest``. Otherwise its region gets the next seed label
+    and its mean cell goes to ``centres``. Returns the number of heads.
+    """
+    rows, cols = hmap.shape
+    stamp = np.zeros((rows, cols), dtype=np.int64)  # 1 + the last candidate to visit a cell
+    region = np.empty((rows * cols, 2), dtype=np.int64)  # a region's cells, in visiting order
+    heads = np.empty((peak_i.shape[0], 2), dtype=np.int64)  # the accepted peaks
+    accepted = 0
+    for p in range(peak_i.shape[0]):
+        i, j = peak_i[p], peak_j[p]
+        near = False
+        for a in range(accepted):
+            di, dj = i - heads[a, 0], j - heads[a, 1]
+            near |= di * di + dj * dj < min_cells2
+        if near:
+            continue
+        # Breadth-first over the window around the peak: the visited cells are the
+        # queue, the cells before ``done`` have had their neighbours looked at.
+        i0, i1 = max(0, i - half), min(rows, i + half + 1)
+        j0, j1 = max(0, j - half), min(cols, j + half + 1)
+        floor = hmap[i, j] - prominence
+        stamp[i, j] = p + 1
+        region[0, 0], region[0, 1] = i, j
+        count = 1
+        done = 0
+        while done < count:
+            ci, cj = region[done, 0], region[done, 1]
+            done += 1
+            for ni in range(max(i0, ci - 1), min(i1, ci + 2)):
+                for nj in range(max(j0, cj - 1), min(j1, cj + 2)):
+                    if stamp[ni, nj] != p + 1 and hmap[ni, nj] >= floor:
+                        stamp[ni, nj] = p + 1
+                        region[count, 0], region[count, 1] = ni, nj
+                        count += 1
+        clash = False
+        for k in range(count):
+            ci, cj = region[k, 0], region[k, 1]
+            clash |= seeds[ci, cj] > 0 or hmap[ci, cj] > highest
+        if clash:
+            continue
+        heads[accepted, 0], heads[accepted, 1] = i, j
+        accepted += 1
+        sum_i = 0
+        sum_j = 0
+        for k in range(count):
+            seeds[region[k, 0], region[k, 1]] = accepted
+            sum_i += region[k, 0] - i0
+            sum_j += region[k, 1] - j0
+        # Exact integer sums: the values of ``rows.sum() / rows.size + i0`` in numpy.
+        centres[accepted - 1, 0] = sum_i / count + i0
+        centres[accepted - 1, 1] = sum_j / count + j0
+    return accepted
+
+
+#: Compiled on first use, cached on disk.
+_grow_heads_kernel: Callable[
+    [FloatArray, IntArray, IntArray, int, float, float, float, IntArray, FloatArray], int
+] = numba.njit(cache=True)(_grow_heads)
 
 
 @lru_cache(maxsize=8)
@@ -403,12 +471,6 @@ def _maximum_filter(image: FloatArray, radius: int) -> FloatArray:
     return np.asarray(out, dtype=np.float64)
 
 
-def _components8(mask: NDArray[np.bool_]) -> NDArray[np.int32]:
-    """8-connected components of a mask (0 = background); the partition of ``ndimage.label``."""
-    _, labels = cv2.connectedComponents(mask.view(np.uint8), connectivity=8)
-    return np.asarray(labels, dtype=np.int32)
-
-
 def find_heads(
     ground_xy: FloatArray,
     heights: FloatArray,
@@ -427,8 +489,7 @@ def find_heads(
         return np.zeros((0, 2))
     hmap, _, origin, _ = _height_map(ground_xy, heights, cell, head_heights[1])
     _, centres = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
-    cells = np.asarray(centres, dtype=np.float64).reshape(-1, 2)
-    heads: FloatArray = origin + (cells - 1 + 0.5) * cell
+    heads: FloatArray = origin + (centres - 1 + 0.5) * cell
     return heads
 
 
@@ -462,7 +523,7 @@ def split_by_heads(
         )
         seeds, heads = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
         n_seeds = int(seeds.max())
-        if not heads:  # no person in it: left whole (the height filter judges it)
+        if heads.shape[0] == 0:  # no person in it: left whole (the height filter judges it)
             out[members] = next_label
             next_label += 1
             continue
