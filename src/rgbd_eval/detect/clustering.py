@@ -204,23 +204,42 @@ def connected_components(pairs: IntArray, n: int) -> IntArray:
 
 def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> IntArray:
     """Drop labels with too few/many points; renumber the rest by first occurrence."""
-    valid = labels >= 0
-    if not valid.any():
-        return np.full(labels.shape, -1, dtype=np.int64)
-    lab = labels[valid]
-    k = int(lab.max()) + 1
-    counts = np.bincount(lab, minlength=k)
-    keep = counts >= max(min_points, 1)  # labels that do not occur are never kept
-    if max_points is not None:
-        keep &= counts <= max_points
-    first = np.full(k, lab.shape[0])  # each label's first occurrence
-    np.minimum.at(first, lab, np.arange(lab.shape[0]))
-    kept = np.flatnonzero(keep)[np.argsort(first[keep])]
-    lookup = np.full(k, -1, dtype=np.int64)
-    lookup[kept] = np.arange(kept.shape[0], dtype=np.int64)
-    out = np.full(labels.shape, -1, dtype=np.int64)
-    out[valid] = lookup[lab]
+    most = np.iinfo(np.int64).max if max_points is None else max_points
+    return _keep_sizes_kernel(
+        np.ascontiguousarray(labels, dtype=np.int64), max(min_points, 1), most
+    )
+
+
+def _keep_sizes_loop(labels: IntArray, least: int, most: int) -> IntArray:
+    """:func:`_keep_sizes` with ``least <= size <= most``, counting, then renumbering."""
+    k = labels.max() + 1 if labels.shape[0] else 0
+    counts = np.zeros(max(k, 0), dtype=np.int64)
+    for label in labels:
+        if label >= 0:
+            counts[label] += 1
+    # -2: not met yet; -1: met, dropped; else the new label, in order of first meeting.
+    lookup = np.full(counts.shape[0], -2, dtype=np.int64)
+    kept = 0
+    out = np.empty(labels.shape[0], dtype=np.int64)
+    for i in range(labels.shape[0]):
+        label = labels[i]
+        if label < 0:
+            out[i] = -1
+            continue
+        if lookup[label] == -2:
+            if least <= counts[label] <= most:
+                lookup[label] = kept
+                kept += 1
+            else:
+                lookup[label] = -1
+        out[i] = lookup[label]
     return out
+
+
+#: Compiled on first use, cached on disk.
+_keep_sizes_kernel: Callable[[IntArray, int, int], IntArray] = numba.njit(cache=True)(
+    _keep_sizes_loop
+)
 
 
 def group_extrema(groups: IntArray, values: FloatArray, k: int) -> tuple[FloatArray, FloatArray]:
