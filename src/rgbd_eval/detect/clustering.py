@@ -330,28 +330,59 @@ def _height_map(
     people, seen from below). A wall continues down, so it stays in the map,
     taller than any person.
     """
-    origin = np.array([ground_xy[:, 0].min(), ground_xy[:, 1].min()])  # faster than axis=0
-    ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1
-    shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
-    # ``ufunc.at`` is fast with a flat index, slow with a tuple of row and column indices.
-    flat = ij[:, 0] * shape[1] + ij[:, 1]
-    high = heights > max_height
-    hmap = np.zeros(shape[0] * shape[1])
-    np.maximum.at(hmap, flat[~high], heights[~high])
-    overhang = np.zeros(heights.shape, dtype=bool)
-    if high.any():
-        lowest_high = np.full(hmap.shape, np.inf)
-        np.minimum.at(lowest_high, flat[high], heights[high])
-        top_high = np.zeros(hmap.shape)
-        np.maximum.at(top_high, flat[high], heights[high])
-        # A column is continuous when no gap wider than OVERHANG_GAP separates its
-        # points above max_height from those below (or from max_height itself).
-        floor_of_gap = np.maximum(hmap, max_height - OVERHANG_GAP)
-        tall = np.isfinite(lowest_high) & (lowest_high - floor_of_gap <= OVERHANG_GAP)
-        hmap[tall] = top_high[tall]
-        overhang = high & ~tall[flat]
-    hmap = hmap.reshape(shape)
+    return _height_map_kernel(
+        np.ascontiguousarray(ground_xy, dtype=np.float64),
+        np.ascontiguousarray(heights, dtype=np.float64),
+        float(cell),
+        float(max_height),
+        OVERHANG_GAP,
+    )
+
+
+def _height_map_loop(
+    ground_xy: FloatArray, heights: FloatArray, cell: float, max_height: float, gap: float
+) -> tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]]:
+    """:func:`_height_map` with ``OVERHANG_GAP`` = ``gap``; every value as numpy computes it."""
+    n = ground_xy.shape[0]
+    origin = np.array([ground_xy[:, 0].min(), ground_xy[:, 1].min()])
+    ij = np.empty((n, 2), dtype=np.int64)
+    for p in range(n):
+        for d in range(2):
+            ij[p, d] = np.int64(np.floor((ground_xy[p, d] - origin[d]) / cell)) + 1
+    rows, cols = ij[:, 0].max() + 2, ij[:, 1].max() + 2
+    hmap = np.zeros((rows, cols))
+    lowest_high = np.full((rows, cols), np.inf)  # the points above max_height, per cell
+    top_high = np.zeros((rows, cols))
+    for p in range(n):
+        i, j, h = ij[p, 0], ij[p, 1], heights[p]
+        # Replaced only by a strictly higher (lower) value, as ``np.maximum.at`` does.
+        if h > max_height:
+            if h < lowest_high[i, j]:
+                lowest_high[i, j] = h
+            if h > top_high[i, j]:
+                top_high[i, j] = h
+        elif h > hmap[i, j]:
+            hmap[i, j] = h
+    # A column is continuous when no gap wider than ``gap`` separates its points
+    # above max_height from those below (or from max_height itself).
+    tall = np.zeros((rows, cols), dtype=np.bool_)
+    for i in range(rows):
+        for j in range(cols):
+            floor_of_gap = max(hmap[i, j], max_height - gap)
+            if np.isfinite(lowest_high[i, j]) and lowest_high[i, j] - floor_of_gap <= gap:
+                tall[i, j] = True
+                hmap[i, j] = top_high[i, j]
+    overhang = np.zeros(n, dtype=np.bool_)
+    for p in range(n):
+        overhang[p] = heights[p] > max_height and not tall[ij[p, 0], ij[p, 1]]
     return hmap, ij, origin, overhang
+
+
+#: Compiled on first use, cached on disk.
+_height_map_kernel: Callable[
+    [FloatArray, FloatArray, float, float, float],
+    tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]],
+] = numba.njit(cache=True)(_height_map_loop)
 
 
 def _head_seeds(
