@@ -104,7 +104,9 @@ def _grid_components(
             cell_start[n_cells] = s
             n_cells += 1
     cell_start[n_cells] = n
-    cell_keys = keys[cell_start[:n_cells]]
+    cell_keys = np.empty(n_cells, dtype=np.int64)
+    for c in range(n_cells):
+        cell_keys[c] = keys[cell_start[c]]
     # Each pair once: a cell with itself and with the cell above it (dz = 1), and
     # with the three cells (dz = -1..1) of each column ahead: (dx, dy) = (0, 1),
     # (1, -1), (1, 0), (1, 1). Their keys grow with the cell's key, so each
@@ -138,10 +140,14 @@ def _grid_components(
                     d2 += e * e
                     e = points[s, 2] - points[t, 2]
                     d2 += e * e
-                    if d2 <= r2:
-                        _union_kernel(parent, s, t)
+                    if d2 <= r2:  # join the trees: the larger root under the smaller
+                        a, b = _find_kernel(parent, s), _find_kernel(parent, t)
+                        if a < b:
+                            parent[b] = a
+                        elif b < a:
+                            parent[a] = b
     # Back to the input order, each component named by its smallest input index.
-    smallest = np.full(n, n)
+    smallest = np.zeros(n, dtype=np.int64) + n
     for s in range(n):
         root = _find_kernel(parent, s)
         smallest[root] = min(smallest[root], order[s])
@@ -159,19 +165,9 @@ def _find(parent: IntArray, i: int) -> int:
     return i
 
 
-def _union(parent: IntArray, i: int, j: int) -> None:
-    """Join the trees of ``i`` and ``j``: the larger root goes under the smaller."""
-    a, b = _find_kernel(parent, i), _find_kernel(parent, j)
-    if a < b:
-        parent[b] = a
-    elif b < a:
-        parent[a] = b
-
-
 #: Compiled on first use, cached on disk; no ``fastmath``: the distance test rounds
 #: operation by operation, as scipy's.
 _find_kernel: Callable[[IntArray, int], int] = numba.njit(cache=True)(_find)
-_union_kernel: Callable[[IntArray, int, int], None] = numba.njit(cache=True)(_union)
 _grid_components_kernel: Callable[[FloatArray, IntArray, IntArray, int, int, float], IntArray] = (
     numba.njit(cache=True)(_grid_components)
 )
@@ -212,13 +208,15 @@ def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> In
 
 def _keep_sizes_loop(labels: IntArray, least: int, most: int) -> IntArray:
     """:func:`_keep_sizes` with ``least <= size <= most``, counting, then renumbering."""
-    k = labels.max() + 1 if labels.shape[0] else 0
-    counts = np.zeros(max(k, 0), dtype=np.int64)
+    k = 0
+    for label in labels:
+        k = max(k, label + 1)
+    counts = np.zeros(k, dtype=np.int64)
     for label in labels:
         if label >= 0:
             counts[label] += 1
     # -2: not met yet; -1: met, dropped; else the new label, in order of first meeting.
-    lookup = np.full(counts.shape[0], -2, dtype=np.int64)
+    lookup = np.zeros(k, dtype=np.int64) - 2
     kept = 0
     out = np.empty(labels.shape[0], dtype=np.int64)
     for i in range(labels.shape[0]):
@@ -330,6 +328,8 @@ def _height_map(
     people, seen from below). A wall continues down, so it stays in the map,
     taller than any person.
     """
+    if ground_xy.shape[0] == 0:
+        raise ValueError("no points for a height map")
     return _height_map_kernel(
         np.ascontiguousarray(ground_xy, dtype=np.float64),
         np.ascontiguousarray(heights, dtype=np.float64),
@@ -344,12 +344,17 @@ def _height_map_loop(
 ) -> tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]]:
     """:func:`_height_map` with ``OVERHANG_GAP`` = ``gap``; every value as numpy computes it."""
     n = ground_xy.shape[0]
-    origin = np.array([ground_xy[:, 0].min(), ground_xy[:, 1].min()])
+    origin = ground_xy[0].copy()
+    for p in range(n):
+        for d in range(2):
+            if ground_xy[p, d] < origin[d]:
+                origin[d] = ground_xy[p, d]
     ij = np.empty((n, 2), dtype=np.int64)
+    rows, cols = 0, 0
     for p in range(n):
         for d in range(2):
             ij[p, d] = np.int64(np.floor((ground_xy[p, d] - origin[d]) / cell)) + 1
-    rows, cols = ij[:, 0].max() + 2, ij[:, 1].max() + 2
+        rows, cols = max(rows, ij[p, 0] + 2), max(cols, ij[p, 1] + 2)
     hmap = np.zeros((rows, cols))
     lowest_high = np.full((rows, cols), np.inf)  # the points above max_height, per cell
     top_high = np.zeros((rows, cols))

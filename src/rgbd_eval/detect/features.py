@@ -214,13 +214,16 @@ def _blob_mask(
     n, k = uv.shape[0], offsets.shape[0]
     u = np.empty((n, k), dtype=np.int64)  # each point's k columns and k rows
     v = np.empty((n, k), dtype=np.int64)
+    # The box spans the blob's pixels on the image (rows and columns off it included).
+    left, right, top, bottom = 2**62, -(2**62), 2**62, -(2**62)  # n >= 1: all replaced
     for i in range(n):
         for j in range(k):
             u[i, j] = np.int64(np.rint(uv[i, 0] + offsets[j]))
             v[i, j] = np.int64(np.rint(uv[i, 1] + offsets[j]))
-    # The box spans the blob's pixels on the image (rows and columns off it included).
-    left, right = max(u.min(), 0), min(u.max(), image_width - 1)
-    top, bottom = max(v.min(), 0), min(v.max(), image_height - 1)
+            left, right = min(left, u[i, j]), max(right, u[i, j])
+            top, bottom = min(top, v[i, j]), max(bottom, v[i, j])
+    left, right = max(left, 0), min(right, image_width - 1)
+    top, bottom = max(top, 0), min(bottom, image_height - 1)
     if left > right or top > bottom:
         return 0, 0, np.zeros((0, 0), dtype=np.bool_)
     mask = np.zeros((bottom - top + 1, right - left + 1), dtype=np.bool_)
