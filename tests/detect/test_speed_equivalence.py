@@ -1,9 +1,9 @@
-"""The vectorised detector code gives the same results as the straightforward one.
+"""The vectorised and compiled detector code gives the same results as the straightforward one.
 
 The ``reference_*`` functions below are the implementations before the speed-up
-(``np.unique`` voxels and size filters, ``scipy.sparse.csgraph`` components,
-``np.maximum.at`` height maps, ``ndimage`` peak filter and labelling, blob
-masks over the whole image), kept verbatim but for their docstrings. The tests
+(``np.unique`` voxels and size filters, ``cKDTree`` pairs and ``scipy.sparse.csgraph``
+components, ``np.maximum.at`` height maps, ``ndimage`` peak filter and labelling,
+blob masks over the whole image), kept verbatim but for their docstrings. The tests
 drive both with random inputs and compare the outputs exactly.
 """
 
@@ -357,19 +357,40 @@ def test_group_extrema_match_ufunc_at(seed: int, k: int, n: int) -> None:
 
 @settings(max_examples=100, deadline=None)
 @given(SEEDS, st.integers(1, 25), st.integers(1, 25), st.integers(1, 4))
-def test_map_filter_and_labels_match_ndimage(seed: int, rows: int, cols: int, radius: int) -> None:
+def test_map_filter_matches_ndimage(seed: int, rows: int, cols: int, radius: int) -> None:
     rng = np.random.default_rng(seed)
     image = np.where(rng.random((rows, cols)) < 0.3, 0.0, rng.normal(1.0, 1.0, (rows, cols)))
     yy, xx = np.mgrid[-radius : radius + 1, -radius : radius + 1]
     disk = yy * yy + xx * xx <= radius * radius
     want = ndimage.maximum_filter(image, footprint=disk, mode="constant")
     assert np.array_equal(clustering._maximum_filter(image, radius), want)
-    mask = image > 0.8
-    ours = clustering._components8(mask)
-    theirs, _ = ndimage.label(mask, structure=np.ones((3, 3), dtype=bool))
-    # The same partition: a one-to-one map between the two labellings.
-    pairs = np.unique(np.stack([ours.ravel(), theirs.ravel()]), axis=1)
-    assert np.unique(pairs[0]).size == np.unique(pairs[1]).size == pairs.shape[1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    SEEDS,
+    st.integers(1, 45),
+    st.integers(1, 45),
+    st.sampled_from([0.0, 0.1, 0.3]),
+    st.sampled_from([(1.4, 2.3), (0.0, np.inf), (-1.0, 2.0)]),
+)
+def test_head_seeds_match_reference(
+    seed: int, rows: int, cols: int, prominence: float, head_heights: tuple[float, float]
+) -> None:
+    rng = np.random.default_rng(seed)
+    # Bumps of person-like heights in 2 cm steps (plateaus, ties), some cells empty.
+    yy, xx = np.mgrid[0:rows, 0:cols]
+    hmap = np.zeros((rows, cols))
+    for _ in range(rng.integers(0, 6)):
+        ci, cj, width = rng.uniform(0, rows), rng.uniform(0, cols), rng.uniform(1.0, 6.0)
+        bump = rng.uniform(1.0, 2.6) * np.exp(-((yy - ci) ** 2 + (xx - cj) ** 2) / width**2)
+        hmap = np.maximum(hmap, bump)
+    hmap = np.round((hmap + rng.uniform(0, 0.3, hmap.shape)) / 0.02) * 0.02
+    hmap[rng.random(hmap.shape) < 0.1] = 0.0
+    seeds, centres = clustering._head_seeds(hmap, 0.06, 0.3, prominence, head_heights)
+    want_seeds, want_centres = reference_head_seeds(hmap, 0.06, 0.3, prominence, head_heights)
+    assert np.array_equal(seeds, want_seeds)
+    assert np.array_equal(centres, np.asarray(want_centres, dtype=np.float64).reshape(-1, 2))
 
 
 @settings(max_examples=150, deadline=None)
@@ -470,6 +491,37 @@ def test_clusters_and_size_filter_match_reference(
         filter_cluster_sizes(labels, min_points, max_points),
         reference_keep_sizes(labels, min_points, max_points),
     )
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    SEEDS,
+    st.integers(1, 600),
+    st.sampled_from([0.12, 0.06 * 2.0, 0.1, 0.35, 1e-7]),
+    st.sampled_from([1e-3, 1.0, 100.0]),
+)
+def test_grid_clusters_match_kdtree_at_the_tolerance(
+    seed: int, n: int, tolerance: float, offset: float
+) -> None:
+    """Pairs at (or a few ulps around) exactly the tolerance are linked as by cKDTree."""
+    rng = np.random.default_rng(seed)
+    # Voxel-centroid-like points: a lattice of voxels (some of step ``tolerance``),
+    # jittered or not, far from the origin or not.
+    step = rng.choice([0.06, tolerance, tolerance / 2])
+    base = (
+        offset + step * rng.integers(0, 12, (n, 3)) + rng.choice([0.0, 1e-3]) * rng.random((n, 3))
+    )
+    # Partners displaced along one axis by the tolerance, nudged by -2..2 ulps.
+    axis = rng.integers(0, 3, n)
+    moved = base.copy()
+    moved[np.arange(n), axis] += tolerance
+    for _ in range(2):
+        nudge = rng.integers(-1, 2, (n, 1)) * (np.arange(3) == axis[:, None])
+        moved = np.where(nudge > 0, np.nextafter(moved, np.inf), moved)
+        moved = np.where(nudge < 0, np.nextafter(moved, -np.inf), moved)
+    points = np.concatenate([base, moved])[rng.permutation(2 * n)]
+    got = euclidean_clusters(points, tolerance, 1)
+    assert np.array_equal(got, reference_euclidean_clusters(points, tolerance, 1))
 
 
 @settings(max_examples=100, deadline=None)

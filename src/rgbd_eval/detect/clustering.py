@@ -24,9 +24,11 @@ Labels are integers per point, ``-1`` for "no cluster".
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import lru_cache
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
@@ -54,16 +56,121 @@ def euclidean_clusters(points: FloatArray, tolerance: float, min_points: int) ->
 
     Components smaller than ``min_points`` get label -1. Labels are renumbered
     0..K-1 in order of each component's first point (deterministic).
+
+    The graph is that of ``cKDTree.query_pairs(tolerance)`` (p = 2): two points
+    are linked when their squared distance, summed over x, y, z in that order, is
+    ``<= tolerance * tolerance``, so points exactly ``tolerance`` apart are linked
+    as there. Candidate pairs come from a uniform grid of cells a hair wider than
+    ``tolerance`` (no rounding of the cell indices can then put two linked points
+    two cells apart), see :func:`_grid_components`.
     """
     if not tolerance > 0:
         raise ValueError(f"tolerance must be positive, got {tolerance}")
     n = points.shape[0]
     if n == 0:
         return np.zeros(0, dtype=np.int64)
-    # Unbalanced, non-compact trees build faster and query as fast here.
-    tree = cKDTree(points, balanced_tree=False, compact_nodes=False)
-    pairs = tree.query_pairs(tolerance, output_type="ndarray")
-    return _keep_sizes(connected_components(pairs, n), min_points, None)
+    columns = [points[:, d] for d in range(3)]  # column-wise: (N, 3).min(axis=0) is slow
+    lo = np.array([float(column.min()) for column in columns])
+    extent = max(float(column.max()) - low for column, low in zip(columns, lo, strict=True))
+    # Wider cells only cost distance tests; at most 2**20 cells per axis keep the
+    # cell keys below 2**63.
+    cell = max(tolerance * (1.0 + 1e-6), extent / 2.0**20)
+    idx = np.floor((points - lo) / cell).astype(np.int64) + 1  # >= 1: neighbours >= 0
+    ny, nz = int(idx[:, 1].max()) + 2, int(idx[:, 2].max()) + 2
+    # Cell keys in z-fastest order: a column's cells (dz = -1, 0, 1) have consecutive keys.
+    keys = (idx[:, 0] * ny + idx[:, 1]) * nz + idx[:, 2]
+    order = np.argsort(keys, kind="stable")
+    labels = _grid_components_kernel(
+        np.take(points, order, axis=0), keys[order], order, ny, nz, tolerance * tolerance
+    )
+    return _keep_sizes(labels, min_points, None)
+
+
+def _grid_components(
+    points: FloatArray, keys: IntArray, order: IntArray, ny: int, nz: int, r2: float
+) -> IntArray:
+    """Each point labelled with the smallest input index of its component.
+
+    ``points`` ``(N, 3)`` are sorted by cell, ``keys`` their cell keys
+    ``(ix * ny + iy) * nz + iz``, ``order`` their input indices; points are linked
+    when their squared distance is ``<= r2``.
+    """
+    n = points.shape[0]
+    # Cells: their keys and first positions (cell_start[n_cells] = n).
+    cell_start = np.empty(n + 1, dtype=np.int64)
+    n_cells = 0
+    for s in range(n):
+        if s == 0 or keys[s] != keys[s - 1]:
+            cell_start[n_cells] = s
+            n_cells += 1
+    cell_start[n_cells] = n
+    cell_keys = np.empty(n_cells, dtype=np.int64)
+    for c in range(n_cells):
+        cell_keys[c] = keys[cell_start[c]]
+    # Each pair once: a cell with itself and with the cell above it (dz = 1), and
+    # with the three cells (dz = -1..1) of each column ahead: (dx, dy) = (0, 1),
+    # (1, -1), (1, 0), (1, 1). Their keys grow with the cell's key, so each
+    # column ahead is found by a pointer moving forward through the sorted cells.
+    ahead = np.array([nz, (ny - 1) * nz, ny * nz, (ny + 1) * nz])
+    pointer = np.zeros(4, dtype=np.int64)
+    first = np.empty(5, dtype=np.int64)  # the position ranges to test against
+    last = np.empty(5, dtype=np.int64)
+    parent = np.arange(n)  # union-find over positions in cell order
+    for c in range(n_cells):
+        key = cell_keys[c]
+        above = c + 1 < n_cells and cell_keys[c + 1] == key + 1
+        last[0] = cell_start[c + 2] if above else cell_start[c + 1]
+        for col in range(4):
+            centre = key + ahead[col]
+            q = pointer[col]
+            while q < n_cells and cell_keys[q] < centre - 1:
+                q += 1
+            pointer[col] = q
+            r = q
+            while r < n_cells and cell_keys[r] <= centre + 1:
+                r += 1
+            first[col + 1], last[col + 1] = cell_start[q], cell_start[r]
+        for s in range(cell_start[c], cell_start[c + 1]):
+            first[0] = s + 1  # pairs within the cell once
+            for k in range(5):
+                for t in range(first[k], last[k]):
+                    e = points[s, 0] - points[t, 0]
+                    d2 = e * e
+                    e = points[s, 1] - points[t, 1]
+                    d2 += e * e
+                    e = points[s, 2] - points[t, 2]
+                    d2 += e * e
+                    if d2 <= r2:  # join the trees: the larger root under the smaller
+                        a, b = _find_kernel(parent, s), _find_kernel(parent, t)
+                        if a < b:
+                            parent[b] = a
+                        elif b < a:
+                            parent[a] = b
+    # Back to the input order, each component named by its smallest input index.
+    smallest = np.zeros(n, dtype=np.int64) + n
+    for s in range(n):
+        root = _find_kernel(parent, s)
+        smallest[root] = min(smallest[root], order[s])
+    labels = np.empty(n, dtype=np.int64)
+    for s in range(n):
+        labels[order[s]] = smallest[parent[s]]
+    return labels
+
+
+def _find(parent: IntArray, i: int) -> int:
+    """Root of ``i`` in the union-find forest, halving the path on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+#: Compiled on first use, cached on disk; no ``fastmath``: the distance test rounds
+#: operation by operation, as scipy's.
+_find_kernel: Callable[[IntArray, int], int] = numba.njit(cache=True)(_find)
+_grid_components_kernel: Callable[[FloatArray, IntArray, IntArray, int, int, float], IntArray] = (
+    numba.njit(cache=True)(_grid_components)
+)
 
 
 def connected_components(pairs: IntArray, n: int) -> IntArray:
@@ -93,23 +200,44 @@ def connected_components(pairs: IntArray, n: int) -> IntArray:
 
 def _keep_sizes(labels: IntArray, min_points: int, max_points: int | None) -> IntArray:
     """Drop labels with too few/many points; renumber the rest by first occurrence."""
-    valid = labels >= 0
-    if not valid.any():
-        return np.full(labels.shape, -1, dtype=np.int64)
-    lab = labels[valid]
-    k = int(lab.max()) + 1
-    counts = np.bincount(lab, minlength=k)
-    keep = counts >= max(min_points, 1)  # labels that do not occur are never kept
-    if max_points is not None:
-        keep &= counts <= max_points
-    first = np.full(k, lab.shape[0])  # each label's first occurrence
-    np.minimum.at(first, lab, np.arange(lab.shape[0]))
-    kept = np.flatnonzero(keep)[np.argsort(first[keep])]
-    lookup = np.full(k, -1, dtype=np.int64)
-    lookup[kept] = np.arange(kept.shape[0], dtype=np.int64)
-    out = np.full(labels.shape, -1, dtype=np.int64)
-    out[valid] = lookup[lab]
+    most = np.iinfo(np.int64).max if max_points is None else max_points
+    return _keep_sizes_kernel(
+        np.ascontiguousarray(labels, dtype=np.int64), max(min_points, 1), most
+    )
+
+
+def _keep_sizes_loop(labels: IntArray, least: int, most: int) -> IntArray:
+    """:func:`_keep_sizes` with ``least <= size <= most``, counting, then renumbering."""
+    k = 0
+    for label in labels:
+        k = max(k, label + 1)
+    counts = np.zeros(k, dtype=np.int64)
+    for label in labels:
+        if label >= 0:
+            counts[label] += 1
+    # -2: not met yet; -1: met, dropped; else the new label, in order of first meeting.
+    lookup = np.zeros(k, dtype=np.int64) - 2
+    kept = 0
+    out = np.empty(labels.shape[0], dtype=np.int64)
+    for i in range(labels.shape[0]):
+        label = labels[i]
+        if label < 0:
+            out[i] = -1
+            continue
+        if lookup[label] == -2:
+            if least <= counts[label] <= most:
+                lookup[label] = kept
+                kept += 1
+            else:
+                lookup[label] = -1
+        out[i] = lookup[label]
     return out
+
+
+#: Compiled on first use, cached on disk.
+_keep_sizes_kernel: Callable[[IntArray, int, int], IntArray] = numba.njit(cache=True)(
+    _keep_sizes_loop
+)
 
 
 def group_extrema(groups: IntArray, values: FloatArray, k: int) -> tuple[FloatArray, FloatArray]:
@@ -200,28 +328,66 @@ def _height_map(
     people, seen from below). A wall continues down, so it stays in the map,
     taller than any person.
     """
-    origin = np.array([ground_xy[:, 0].min(), ground_xy[:, 1].min()])  # faster than axis=0
-    ij = np.floor((ground_xy - origin) / cell).astype(np.int64) + 1
-    shape = (int(ij[:, 0].max()) + 2, int(ij[:, 1].max()) + 2)
-    # ``ufunc.at`` is fast with a flat index, slow with a tuple of row and column indices.
-    flat = ij[:, 0] * shape[1] + ij[:, 1]
-    high = heights > max_height
-    hmap = np.zeros(shape[0] * shape[1])
-    np.maximum.at(hmap, flat[~high], heights[~high])
-    overhang = np.zeros(heights.shape, dtype=bool)
-    if high.any():
-        lowest_high = np.full(hmap.shape, np.inf)
-        np.minimum.at(lowest_high, flat[high], heights[high])
-        top_high = np.zeros(hmap.shape)
-        np.maximum.at(top_high, flat[high], heights[high])
-        # A column is continuous when no gap wider than OVERHANG_GAP separates its
-        # points above max_height from those below (or from max_height itself).
-        floor_of_gap = np.maximum(hmap, max_height - OVERHANG_GAP)
-        tall = np.isfinite(lowest_high) & (lowest_high - floor_of_gap <= OVERHANG_GAP)
-        hmap[tall] = top_high[tall]
-        overhang = high & ~tall[flat]
-    hmap = hmap.reshape(shape)
+    if ground_xy.shape[0] == 0:
+        raise ValueError("no points for a height map")
+    return _height_map_kernel(
+        np.ascontiguousarray(ground_xy, dtype=np.float64),
+        np.ascontiguousarray(heights, dtype=np.float64),
+        float(cell),
+        float(max_height),
+        OVERHANG_GAP,
+    )
+
+
+def _height_map_loop(
+    ground_xy: FloatArray, heights: FloatArray, cell: float, max_height: float, gap: float
+) -> tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]]:
+    """:func:`_height_map` with ``OVERHANG_GAP`` = ``gap``; every value as numpy computes it."""
+    n = ground_xy.shape[0]
+    origin = ground_xy[0].copy()
+    for p in range(n):
+        for d in range(2):
+            if ground_xy[p, d] < origin[d]:
+                origin[d] = ground_xy[p, d]
+    ij = np.empty((n, 2), dtype=np.int64)
+    rows, cols = 0, 0
+    for p in range(n):
+        for d in range(2):
+            ij[p, d] = np.int64(np.floor((ground_xy[p, d] - origin[d]) / cell)) + 1
+        rows, cols = max(rows, ij[p, 0] + 2), max(cols, ij[p, 1] + 2)
+    hmap = np.zeros((rows, cols))
+    lowest_high = np.full((rows, cols), np.inf)  # the points above max_height, per cell
+    top_high = np.zeros((rows, cols))
+    for p in range(n):
+        i, j, h = ij[p, 0], ij[p, 1], heights[p]
+        # Replaced only by a strictly higher (lower) value, as ``np.maximum.at`` does.
+        if h > max_height:
+            if h < lowest_high[i, j]:
+                lowest_high[i, j] = h
+            if h > top_high[i, j]:
+                top_high[i, j] = h
+        elif h > hmap[i, j]:
+            hmap[i, j] = h
+    # A column is continuous when no gap wider than ``gap`` separates its points
+    # above max_height from those below (or from max_height itself).
+    tall = np.zeros((rows, cols), dtype=np.bool_)
+    for i in range(rows):
+        for j in range(cols):
+            floor_of_gap = max(hmap[i, j], max_height - gap)
+            if np.isfinite(lowest_high[i, j]) and lowest_high[i, j] - floor_of_gap <= gap:
+                tall[i, j] = True
+                hmap[i, j] = top_high[i, j]
+    overhang = np.zeros(n, dtype=np.bool_)
+    for p in range(n):
+        overhang[p] = heights[p] > max_height and not tall[ij[p, 0], ij[p, 1]]
     return hmap, ij, origin, overhang
+
+
+#: Compiled on first use, cached on disk.
+_height_map_kernel: Callable[
+    [FloatArray, FloatArray, float, float, float],
+    tuple[FloatArray, IntArray, FloatArray, NDArray[np.bool_]],
+] = numba.njit(cache=True)(_height_map_loop)
 
 
 def _head_seeds(
@@ -230,7 +396,7 @@ def _head_seeds(
     min_head_distance: float,
     min_head_prominence: float,
     head_heights: tuple[float, float],
-) -> tuple[IntArray, list[FloatArray]]:
+) -> tuple[IntArray, FloatArray]:
     """Seed regions of the map (0 = none): the heads first (1..H), then tall structures.
 
     Returns the seed map and the head-region centres (cell coordinates), highest first.
@@ -248,30 +414,98 @@ def _head_seeds(
     # a second peak closer than ``min_head_distance``, which is dropped anyway.
     half = max(1, int(np.ceil(HEAD_SEARCH_RADIUS / cell)))
     min_cells2 = (min_head_distance / cell) ** 2
-    accepted: list[tuple[int, int]] = []
-    centres: list[FloatArray] = []
-    for i, j in zip(pi[order].tolist(), pj[order].tolist(), strict=True):
-        if any((i - a) ** 2 + (j - b) ** 2 < min_cells2 for a, b in accepted):
-            continue
-        # The head's region: cells reachable from the peak without descending by the
-        # prominence. Another head or a taller structure inside it makes this peak
-        # part of that (followed within HEAD_SEARCH_RADIUS of the peak).
-        i0, j0 = max(0, i - half), max(0, j - half)
-        window = hmap[i0 : i + half + 1, j0 : j + half + 1]
-        regions = _components8(window >= hmap[i, j] - min_head_prominence)
-        mine = regions == regions[i - i0, j - j0]
-        taken = seeds[i0 : i + half + 1, j0 : j + half + 1]
-        if (mine & ((taken > 0) | (window > highest))).any():
-            continue
-        accepted.append((i, j))
-        taken[mine] = len(accepted)
-        ri, rj = np.nonzero(mine)
-        # Means of small integers, exact sums: ``ri.mean()`` without its overhead.
-        centres.append(np.array([ri.sum() / ri.size + i0, rj.sum() / rj.size + j0]))
+    centres = np.empty((order.shape[0], 2))
+    accepted = _grow_heads_kernel(
+        hmap,
+        pi[order],
+        pj[order],
+        half,
+        min_cells2,
+        float(min_head_prominence),
+        float(highest),
+        seeds,
+        centres,
+    )
     if tall.any():
         tall_regions, _ = ndimage.label(tall, structure=np.ones((3, 3), dtype=bool))
-        seeds[tall] = tall_regions[tall] + len(accepted)
-    return seeds, centres
+        seeds[tall] = tall_regions[tall] + accepted
+    return seeds, centres[:accepted]
+
+
+def _grow_heads(
+    hmap: FloatArray,
+    peak_i: IntArray,
+    peak_j: IntArray,
+    half: int,
+    min_cells2: float,
+    prominence: float,
+    highest: float,
+    seeds: IntArray,
+    centres: FloatArray,
+) -> int:
+    """Accept the candidate peaks as heads in turn, growing their regions in ``seeds``.
+
+    A peak is dropped when closer than ``sqrt(min_cells2)`` cells to an accepted
+    head, or when its region (the cells 8-connected to it at or above its height
+    minus ``prominence``, within ``half`` cells of it) holds another head's cell
+    or a cell above ``highest``. Otherwise its region gets the next seed label
+    and its mean cell goes to ``centres``. Returns the number of heads.
+    """
+    rows, cols = hmap.shape
+    stamp = np.zeros((rows, cols), dtype=np.int64)  # 1 + the last candidate to visit a cell
+    region = np.empty((rows * cols, 2), dtype=np.int64)  # a region's cells, in visiting order
+    heads = np.empty((peak_i.shape[0], 2), dtype=np.int64)  # the accepted peaks
+    accepted = 0
+    for p in range(peak_i.shape[0]):
+        i, j = peak_i[p], peak_j[p]
+        near = False
+        for a in range(accepted):
+            di, dj = i - heads[a, 0], j - heads[a, 1]
+            near |= di * di + dj * dj < min_cells2
+        if near:
+            continue
+        # Breadth-first over the window around the peak: the visited cells are the
+        # queue, the cells before ``done`` have had their neighbours looked at.
+        i0, i1 = max(0, i - half), min(rows, i + half + 1)
+        j0, j1 = max(0, j - half), min(cols, j + half + 1)
+        floor = hmap[i, j] - prominence
+        stamp[i, j] = p + 1
+        region[0, 0], region[0, 1] = i, j
+        count = 1
+        done = 0
+        while done < count:
+            ci, cj = region[done, 0], region[done, 1]
+            done += 1
+            for ni in range(max(i0, ci - 1), min(i1, ci + 2)):
+                for nj in range(max(j0, cj - 1), min(j1, cj + 2)):
+                    if stamp[ni, nj] != p + 1 and hmap[ni, nj] >= floor:
+                        stamp[ni, nj] = p + 1
+                        region[count, 0], region[count, 1] = ni, nj
+                        count += 1
+        clash = False
+        for k in range(count):
+            ci, cj = region[k, 0], region[k, 1]
+            clash |= seeds[ci, cj] > 0 or hmap[ci, cj] > highest
+        if clash:
+            continue
+        heads[accepted, 0], heads[accepted, 1] = i, j
+        accepted += 1
+        sum_i = 0
+        sum_j = 0
+        for k in range(count):
+            seeds[region[k, 0], region[k, 1]] = accepted
+            sum_i += region[k, 0] - i0
+            sum_j += region[k, 1] - j0
+        # Exact integer sums: the values of ``rows.sum() / rows.size + i0`` in numpy.
+        centres[accepted - 1, 0] = sum_i / count + i0
+        centres[accepted - 1, 1] = sum_j / count + j0
+    return accepted
+
+
+#: Compiled on first use, cached on disk.
+_grow_heads_kernel: Callable[
+    [FloatArray, IntArray, IntArray, int, float, float, float, IntArray, FloatArray], int
+] = numba.njit(cache=True)(_grow_heads)
 
 
 @lru_cache(maxsize=8)
@@ -292,12 +526,6 @@ def _maximum_filter(image: FloatArray, radius: int) -> FloatArray:
     return np.asarray(out, dtype=np.float64)
 
 
-def _components8(mask: NDArray[np.bool_]) -> NDArray[np.int32]:
-    """8-connected components of a mask (0 = background); the partition of ``ndimage.label``."""
-    _, labels = cv2.connectedComponents(mask.view(np.uint8), connectivity=8)
-    return np.asarray(labels, dtype=np.int32)
-
-
 def find_heads(
     ground_xy: FloatArray,
     heights: FloatArray,
@@ -316,8 +544,7 @@ def find_heads(
         return np.zeros((0, 2))
     hmap, _, origin, _ = _height_map(ground_xy, heights, cell, head_heights[1])
     _, centres = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
-    cells = np.asarray(centres, dtype=np.float64).reshape(-1, 2)
-    heads: FloatArray = origin + (cells - 1 + 0.5) * cell
+    heads: FloatArray = origin + (centres - 1 + 0.5) * cell
     return heads
 
 
@@ -351,7 +578,7 @@ def split_by_heads(
         )
         seeds, heads = _head_seeds(hmap, cell, min_head_distance, min_head_prominence, head_heights)
         n_seeds = int(seeds.max())
-        if not heads:  # no person in it: left whole (the height filter judges it)
+        if heads.shape[0] == 0:  # no person in it: left whole (the height filter judges it)
             out[members] = next_label
             next_label += 1
             continue

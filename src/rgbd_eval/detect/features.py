@@ -6,9 +6,11 @@ plane normalised as in :mod:`rgbd_eval.detect.plane` (height = ``n . p + d``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -195,25 +197,51 @@ def blob(uv: FloatArray, footprint: int, rgb_camera: CameraModel) -> Blob:
     RGB pixels per side, so a decimated depth image still yields a solid mask.
     Pixel ``j`` of the ``k`` a point covers per side is ``rint(u + j - (k - 1) / 2)``.
     """
-    empty = Blob(0, 0, np.zeros((0, 0), dtype=bool))
     if uv.shape[0] == 0:
-        return empty
+        return Blob(0, 0, np.zeros((0, 0), dtype=bool))
     k = max(1, int(footprint))
     offsets = np.arange(k, dtype=np.float64) - (k - 1) / 2.0
-    # Each point's k columns and k rows; its pixels are all their pairs.
-    u = np.rint(uv[:, 0:1] + offsets).astype(np.int64)
-    v = np.rint(uv[:, 1:2] + offsets).astype(np.int64)
-    left, right = max(int(u.min()), 0), min(int(u.max()), rgb_camera.width - 1)
-    top, bottom = max(int(v.min()), 0), min(int(v.max()), rgb_camera.height - 1)
+    top, left, mask = _blob_kernel(
+        np.ascontiguousarray(uv, dtype=np.float64), offsets, rgb_camera.width, rgb_camera.height
+    )
+    return Blob(top, left, mask)
+
+
+def _blob_mask(
+    uv: FloatArray, offsets: FloatArray, image_width: int, image_height: int
+) -> tuple[int, int, NDArray[np.bool_]]:
+    """:func:`blob`'s top row, left column and mask, the pixels ``rint(u + offset)``."""
+    n, k = uv.shape[0], offsets.shape[0]
+    u = np.empty((n, k), dtype=np.int64)  # each point's k columns and k rows
+    v = np.empty((n, k), dtype=np.int64)
+    # The box spans the blob's pixels on the image (rows and columns off it included).
+    left, right, top, bottom = 2**62, -(2**62), 2**62, -(2**62)  # n >= 1: all replaced
+    for i in range(n):
+        for j in range(k):
+            u[i, j] = np.int64(np.rint(uv[i, 0] + offsets[j]))
+            v[i, j] = np.int64(np.rint(uv[i, 1] + offsets[j]))
+            left, right = min(left, u[i, j]), max(right, u[i, j])
+            top, bottom = min(top, v[i, j]), max(bottom, v[i, j])
+    left, right = max(left, 0), min(right, image_width - 1)
+    top, bottom = max(top, 0), min(bottom, image_height - 1)
     if left > right or top > bottom:
-        return empty
-    height, width = bottom - top + 1, right - left + 1
-    # Columns and rows off the image go to a spare last column and row of the mask.
-    cols = np.where((u >= 0) & (u < rgb_camera.width), u - left, width)
-    rows = np.where((v >= 0) & (v < rgb_camera.height), v - top, height)
-    mask = np.zeros((height + 1, width + 1), dtype=bool)
-    mask.reshape(-1)[rows[:, :, None] * (width + 1) + cols[:, None, :]] = True
-    return Blob(top, left, mask[:height, :width])
+        return 0, 0, np.zeros((0, 0), dtype=np.bool_)
+    mask = np.zeros((bottom - top + 1, right - left + 1), dtype=np.bool_)
+    for i in range(n):
+        for a in range(k):
+            row = v[i, a]
+            if 0 <= row < image_height:
+                for b in range(k):
+                    col = u[i, b]
+                    if 0 <= col < image_width:
+                        mask[row - top, col - left] = True
+    return top, left, mask
+
+
+#: Compiled on first use, cached on disk.
+_blob_kernel: Callable[[FloatArray, FloatArray, int, int], tuple[int, int, NDArray[np.bool_]]] = (
+    numba.njit(cache=True)(_blob_mask)
+)
 
 
 def colour_histogram(rgb: NDArray[np.uint8], region: Blob, bins: int) -> NDArray[np.float32]:
