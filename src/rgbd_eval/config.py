@@ -297,11 +297,17 @@ def _parse_value(text: str) -> Any:
         return text
 
 
-def _set_dotted(data: dict[str, Any], key: str, value: Any) -> None:
+def set_dotted(
+    data: dict[str, Any], key: str, value: Any, model: type[BaseModel] | None = None
+) -> None:
+    """Set ``a.b.c = value`` in the raw mapping of ``model`` (default :class:`RunConfig`).
+
+    Every segment must be a field of its section; a ConfigError names the unknown key.
+    """
     parts = key.split(".")
     if not all(parts):
         raise ConfigError(f"override {key!r}: empty key segment")
-    fields: Mapping[str, Any] = RunConfig.model_fields
+    fields: Mapping[str, Any] = (model or RunConfig).model_fields
     node = data
     for i, part in enumerate(parts):
         where = ".".join(parts[:i]) or "<root>"
@@ -346,7 +352,7 @@ def build_config(
     """Validate a config mapping with overrides applied on top."""
     merged: dict[str, Any] = _deep_copy(dict(data or {}))
     for key, value in overrides:
-        _set_dotted(merged, key, value)
+        set_dotted(merged, key, value)
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as err:

@@ -18,7 +18,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from rgbd_eval.config import format_validation_error, load_yaml, repo_root
+from rgbd_eval.config import format_validation_error, load_yaml, repo_root, set_dotted
 from rgbd_eval.errors import ConfigError
 
 Colour = tuple[int, int, int]
@@ -386,21 +386,15 @@ def load_scenario(path: Path | str, overrides: Iterable[tuple[str, Any]] = ()) -
     """Read and validate a scenario YAML file, with dotted-key overrides (raises ConfigError).
 
     ``overrides`` are ``(key, value)`` pairs such as ``("recording.rgb_format", "raw")``
-    (see :func:`rgbd_eval.config.parse_overrides`); validation names unknown keys.
+    (see :func:`rgbd_eval.config.parse_overrides`), applied as ``run --set`` applies them.
     """
     p = Path(path)
     data = load_yaml(p)
     for key, value in overrides:
-        node = data
-        *parents, leaf = key.split(".")
-        for part in parents:
-            child = node.setdefault(part, {}) if isinstance(node, dict) else None
-            if not isinstance(child, dict):
-                raise ConfigError(f"{p}: override {key!r}: {part!r} is not a mapping")
-            node = child
-        if not isinstance(node, dict) or not leaf:
-            raise ConfigError(f"{p}: override {key!r}: not a mapping key")
-        node[leaf] = value
+        try:
+            set_dotted(data, key, value, Scenario)
+        except ConfigError as err:
+            raise ConfigError(f"{p}: {err}") from err
     return parse_scenario(data, str(p))
 
 
