@@ -31,7 +31,13 @@ from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError, InputError
 from rgbd_eval.io.benchmark import time_read
 from rgbd_eval.io.reader import open_recording
-from rgbd_eval.pipeline import find_ground_truth, match_ground_truth, score_sequence
+from rgbd_eval.pipeline import (
+    SequenceDetections,
+    find_ground_truth,
+    match_ground_truth,
+    score_sequence,
+    track_sequence,
+)
 from rgbd_eval.track.protocol import create_tracker
 from rgbd_eval.types import Detection, TrackOutput
 
@@ -179,21 +185,12 @@ def one_core() -> tuple[int, ...] | None:
     if not hasattr(os, "sched_setaffinity"):
         return None
     os.sched_setaffinity(0, {min(os.sched_getaffinity(0))})
-    return tuple(sorted(os.sched_getaffinity(0)))
+    return allowed_cpus()
 
 
 def allowed_cpus() -> tuple[int, ...] | None:
     """The CPUs this process may run on (None where the platform does not say)."""
     return tuple(sorted(os.sched_getaffinity(0))) if hasattr(os, "sched_getaffinity") else None
-
-
-def time_tracking(config: RunConfig, stream: list[tuple[int, list[Detection]]]) -> float:
-    """Seconds for a fresh tracker to take ``(stamp, detections)`` frames in order."""
-    tracker = create_tracker(config.method, config)
-    start = time.perf_counter()
-    for stamp, dets in stream:
-        tracker.update(stamp, dets)
-    return time.perf_counter() - start
 
 
 def peak_rss_mib() -> float:
@@ -221,7 +218,7 @@ def _one_repeat(
     tracker = create_tracker(config.method, config)
     stamps: list[int] = []
     tracks: list[tuple[TrackOutput, ...]] = []
-    stream: list[tuple[int, list[Detection]]] = []
+    per_frame: list[tuple[Detection, ...]] = []
     detections = 0
     rgb_size = depth_size = (0, 0)
     start = time.perf_counter()
@@ -241,7 +238,7 @@ def _one_repeat(
         start = time.perf_counter()
         _add(seconds, "track", start - t1)
         stamps.append(frame.stamp_ns)
-        stream.append((frame.stamp_ns, dets))
+        per_frame.append(tuple(dets))
         detections += len(dets)
         rgb_size = (frame.rgb.shape[1], frame.rgb.shape[0])
         depth_size = (frame.depth.shape[1], frame.depth.shape[0])
@@ -254,7 +251,9 @@ def _one_repeat(
     seconds["score"] = gt_s + time.perf_counter() - start
     wall_s = time.perf_counter() - wall
     seconds["other"] = max(0.0, wall_s - sum(seconds.values()))
-    track_alone_s = time_tracking(config, stream)
+    start = time.perf_counter()
+    track_sequence(SequenceDetections(tuple(stamps), tuple(per_frame)), config)
+    track_alone_s = time.perf_counter() - start
     return _Repeat(
         frames=len(stamps),
         seconds=seconds,

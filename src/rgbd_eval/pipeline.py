@@ -8,7 +8,7 @@ scoring.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -69,26 +69,39 @@ def sidecar_path(path: Path) -> Path | None:
     return candidate if candidate.exists() else None
 
 
+def _detect_frames(
+    recording: Recording, config: RunConfig, seconds: dict[str, float]
+) -> Iterator[tuple[int, tuple[Detection, ...]]]:
+    """``(stamp, detections)`` of every frame from a fresh detector.
+
+    Adds the seconds spent reading and detecting to ``seconds["read"]`` and
+    ``seconds["detect"]``; the consumer's time between frames is counted in neither.
+    """
+    detector = create_detector(config.method, config)
+    start = time.perf_counter()
+    for frame in recording.frames():
+        t0 = time.perf_counter()
+        dets = tuple(detector.detect(frame))
+        t1 = time.perf_counter()
+        seconds["read"] += t0 - start
+        seconds["detect"] += t1 - t0
+        yield frame.stamp_ns, dets
+        start = time.perf_counter()
+
+
 def detect_sequence(
     recording: Recording, config: RunConfig, progress: Progress | None = None
 ) -> SequenceDetections:
     """Run the configured detector on every frame (a fresh detector per sequence)."""
-    detector = create_detector(config.method, config)
+    seconds = {"read": 0.0, "detect": 0.0}
     stamps: list[int] = []
     per_frame: list[tuple[Detection, ...]] = []
-    read_s = detect_s = 0.0
-    total = len(recording)
-    start = time.perf_counter()
-    for frame in recording.frames():
-        t0 = time.perf_counter()
-        read_s += t0 - start
-        per_frame.append(tuple(detector.detect(frame)))
-        stamps.append(frame.stamp_ns)
-        start = time.perf_counter()
-        detect_s += start - t0
+    for stamp, dets in _detect_frames(recording, config, seconds):
+        stamps.append(stamp)
+        per_frame.append(dets)
         if progress is not None:
-            progress(len(per_frame), total)
-    return SequenceDetections(tuple(stamps), tuple(per_frame), {"read": read_s, "detect": detect_s})
+            progress(len(per_frame), len(recording))
+    return SequenceDetections(tuple(stamps), tuple(per_frame), seconds)
 
 
 def track_sequence(
@@ -112,29 +125,19 @@ def detect_and_track(
     basso2012's colour histogram) are dropped once the tracker has seen them, so
     memory grows only by the small per-frame records (stamps, boxes, tracks).
     """
-    detector = create_detector(config.method, config)
+    seconds = {"read": 0.0, "detect": 0.0, "track": 0.0}
     tracker = create_tracker(config.method, config)
     stamps: list[int] = []
     per_frame: list[tuple[Detection, ...]] = []
     tracks: list[tuple[TrackOutput, ...]] = []
-    read_s = detect_s = track_s = 0.0
-    total = len(recording)
-    start = time.perf_counter()
-    for frame in recording.frames():
-        t0 = time.perf_counter()
-        dets = tuple(detector.detect(frame))
-        t1 = time.perf_counter()
-        tracks.append(tuple(tracker.update(frame.stamp_ns, dets)))
-        t2 = time.perf_counter()
-        per_frame.append(tuple(replace(d, appearance=None) for d in dets))
-        stamps.append(frame.stamp_ns)
-        read_s += t0 - start
-        detect_s += t1 - t0
-        track_s += t2 - t1
+    for stamp, dets in _detect_frames(recording, config, seconds):
         start = time.perf_counter()
+        tracks.append(tuple(tracker.update(stamp, dets)))
+        seconds["track"] += time.perf_counter() - start
+        stamps.append(stamp)
+        per_frame.append(tuple(replace(d, appearance=None) for d in dets))
         if progress is not None:
-            progress(len(per_frame), total)
-    seconds = {"read": read_s, "detect": detect_s, "track": track_s}
+            progress(len(per_frame), len(recording))
     return SequenceDetections(tuple(stamps), tuple(per_frame), seconds), tuple(tracks)
 
 
