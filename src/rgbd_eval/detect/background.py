@@ -27,9 +27,11 @@ mixtures), which the seed switched to for noise beyond 50 mm (Fig. 10, Matlab's
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Protocol
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -83,21 +85,17 @@ class RunningAverageBackground:
         B, streak = self._state
         if B.shape != z.shape:
             raise ValueError(f"depth image is {z.shape}, the background model is {B.shape}")
-        far = np.isinf(B)
-        foreground: BoolImage = valid & (B - z > self.margin_m)
         alpha = np.float32(1.0 - math.exp(-max(dt_s, 0.0) / self.time_constant_s))
-        known = valid & ~far
-        # Step 1: weighted average on valid pixels with a known background.
-        with np.errstate(invalid="ignore"):
-            np.copyto(B, B + alpha * (z - B), where=known)
-        # Step 2: a farther surface is revealed background: take it at once.
-        np.copyto(B, z, where=known & (z - B > self.margin_m))
-        # Never-seen background: adopt a value seen for init_frames frames in a row.
-        streak[:] = np.where(far & valid, streak + 1, 0)
-        adopt = streak >= self.init_frames
-        if adopt.any():
-            np.copyto(B, z, where=adopt)
-            streak[adopt] = 0
+        foreground = np.empty(z.shape, dtype=np.bool_)
+        _running_average_kernel(
+            np.ascontiguousarray(z).reshape(-1),
+            B.reshape(-1),
+            streak.reshape(-1),
+            alpha,
+            np.float32(self.margin_m),
+            self.init_frames,
+            foreground.reshape(-1),
+        )
         return foreground
 
     def _accumulate(self, z: DepthImage, valid: BoolImage) -> None:
@@ -116,6 +114,44 @@ class RunningAverageBackground:
             self._state = (background, np.zeros(z.shape, dtype=np.int32))
             self._sum = None
             self._count = None
+
+
+def _running_average_step(
+    z: DepthImage,
+    B: DepthImage,
+    streak: NDArray[np.int32],
+    alpha: np.float32,
+    margin: np.float32,
+    init_frames: int,
+    foreground: BoolImage,
+) -> None:
+    """One frame of the running average on flat images, in place (rules: module docstring)."""
+    for i in range(z.shape[0]):
+        zi = z[i]
+        if not math.isfinite(zi):  # invalid: no information, background kept
+            foreground[i] = False
+            streak[i] = 0
+            continue
+        b = B[i]
+        if math.isinf(b):  # never-seen background: foreground, adopted after a streak
+            foreground[i] = True
+            s = streak[i] + 1
+            if s >= init_frames:
+                B[i] = zi
+                s = 0
+            streak[i] = s
+            continue
+        foreground[i] = b - zi > margin
+        b = b + alpha * (zi - b)  # step 1: weighted average
+        if zi - b > margin:  # step 2: a farther surface is revealed background
+            b = zi
+        B[i] = b
+
+
+#: Compiled on first use and cached on disk: one pass instead of a dozen full-image ufuncs.
+_running_average_kernel: Callable[
+    [DepthImage, DepthImage, NDArray[np.int32], np.float32, np.float32, int, BoolImage], None
+] = numba.njit(cache=True)(_running_average_step)
 
 
 class Mog2Background:

@@ -13,8 +13,10 @@ cameras merge by the pixel-wise maximum (Fig. 3).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -100,18 +102,81 @@ def camera_density(
             f"must both be {(cam.height, cam.width)}"
         )
     r = cam.rays() if rays is None else rays
-    z = depth[foreground].astype(np.float64)
-    points = r[foreground] * z[:, None]
-    floor = calibration.floor_from_optical.transform_points(points)
     rows_n, cols_n = grid.shape
-    col = np.floor((floor[:, 0] - grid.x_min) / grid.cell_m)
-    row = np.floor((floor[:, 1] - grid.y_min) / grid.cell_m)
-    keep = (floor[:, 2] > min_height_m) & (col >= 0) & (col < cols_n) & (row >= 0) & (row < rows_n)
-    cells = row[keep].astype(np.int64) * cols_n + col[keep].astype(np.int64)
-    weights = point_weights(points[keep], cam.fx, cam.fy)
-    sums = np.bincount(cells, weights=weights, minlength=rows_n * cols_n)
+    T = calibration.floor_from_optical.matrix()
+    sums = np.zeros(rows_n * cols_n, dtype=np.float64)
+    n_max = int(np.count_nonzero(foreground))
+    cells = np.empty(n_max, dtype=np.int64)
+    heights = np.empty(n_max, dtype=np.float32)
+    n = _bin_kernel(
+        np.ascontiguousarray(depth, dtype=np.float32),
+        np.ascontiguousarray(foreground),
+        np.ascontiguousarray(r[0, :, 0]),
+        np.ascontiguousarray(r[:, 0, 1]),
+        T,
+        grid.x_min,
+        grid.y_min,
+        grid.cell_m,
+        rows_n,
+        cols_n,
+        min_height_m,
+        1.0 / (cam.fx * cam.fy),
+        sums,
+        cells,
+        heights,
+    )
     density = (sums / (grid.cell_m * grid.cell_m)).astype(np.float32).reshape(rows_n, cols_n)
-    return CameraMap(density, cells, floor[keep, 2].astype(np.float32))
+    return CameraMap(density, cells[:n], heights[:n])
+
+
+def _bin_points(
+    depth: NDArray[np.float32],
+    foreground: NDArray[np.bool_],
+    ray_x: F64,
+    ray_y: F64,
+    T: F64,
+    x_min: float,
+    y_min: float,
+    cell: float,
+    rows_n: int,
+    cols_n: int,
+    min_height: float,
+    inv_fxfy: float,
+    sums: F64,
+    cells: NDArray[np.int64],
+    heights: NDArray[np.float32],
+) -> int:
+    """Bin the foreground points of one image (rays separable: x by column, y by row).
+
+    Adds each kept point's weight to ``sums`` at its cell and records the cell and height;
+    returns how many points were kept.
+    """
+    n = 0
+    H, W = depth.shape
+    for v in range(H):
+        for u in range(W):
+            if not foreground[v, u]:
+                continue
+            z = np.float64(depth[v, u])
+            px = ray_x[u] * z
+            py = ray_y[v] * z
+            h = T[2, 0] * px + T[2, 1] * py + T[2, 2] * z + T[2, 3]
+            if not h > min_height:
+                continue
+            col = np.floor((T[0, 0] * px + T[0, 1] * py + T[0, 2] * z + T[0, 3] - x_min) / cell)
+            row = np.floor((T[1, 0] * px + T[1, 1] * py + T[1, 2] * z + T[1, 3] - y_min) / cell)
+            if col < 0 or col >= cols_n or row < 0 or row >= rows_n:
+                continue
+            idx = int(row) * cols_n + int(col)
+            sums[idx] += (px * px + py * py + z * z) * inv_fxfy
+            cells[n] = idx
+            heights[n] = h
+            n += 1
+    return n
+
+
+#: Compiled on first use and cached on disk: one pass over the image, no temporaries.
+_bin_kernel: Callable[..., int] = numba.njit(cache=True)(_bin_points)
 
 
 def merge_maps(maps: list[F32]) -> F32:
