@@ -22,10 +22,14 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
+import yaml
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, ValidationError
+
+from rgbd_eval.errors import ConfigError
 
 from rgbd_eval.sim.meshes import concatenate, rotation_y, rotation_z
 from rgbd_eval.sim.render import Hits, make_scene, overlay_hits, render_hits
@@ -95,6 +99,33 @@ class TofCamera(BaseModel):
         )
         T[:3, 3] = (self.x, self.y, self.z)
         return Pose.from_matrix(T).compose(OPTICAL_TO_BODY)
+
+
+class TofCameraList(BaseModel):
+    """A file of static ToF cameras (``cameras: [...]``)."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+    cameras: list[TofCamera] = Field(min_length=1)
+
+
+def load_tof_cameras(path: Path | str) -> list[TofCamera]:
+    """Read a camera list YAML; :class:`ConfigError` naming the file and the bad field."""
+    p = Path(path)
+    try:
+        raw = yaml.safe_load(p.read_text())
+    except (OSError, yaml.YAMLError) as err:
+        raise ConfigError(f"{p}: cannot read the camera list: {err}") from err
+    try:
+        cameras = TofCameraList.model_validate(raw).cameras
+    except ValidationError as err:
+        first = err.errors()[0]
+        where = ".".join(str(part) for part in first["loc"]) or "(top level)"
+        raise ConfigError(f"{p}: {where}: {first['msg']}") from err
+    names = [c.name for c in cameras]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{p}: camera names must be unique, got {names}")
+    return cameras
 
 
 def radial_position(camera: CameraModel) -> F32:
