@@ -54,7 +54,9 @@ def test_noise_grows_with_depth_squared_and_off_centre() -> None:
     np.testing.assert_allclose(tof_sigma(z, rho2, spec), [[0.005, 0.00125, 0.01]], rtol=1e-6)
     noisy = TofCamera(name="c", x=0, y=0, z=2, extra_noise_m=0.05)
     # Added noise is independent: sqrt(0.005^2 + 0.05^2)
-    assert float(tof_sigma(z[:, :1], rho2[:, :1], noisy)[0, 0]) == pytest.approx(math.hypot(0.005, 0.05), rel=1e-6)
+    assert float(tof_sigma(z[:, :1], rho2[:, :1], noisy)[0, 0]) == pytest.approx(
+        math.hypot(0.005, 0.05), rel=1e-6
+    )
 
 
 def test_radial_position_is_zero_at_centre_and_near_one_in_corners() -> None:
@@ -64,11 +66,15 @@ def test_radial_position_is_zero_at_centre_and_near_one_in_corners() -> None:
     assert float(rho2[0, 0]) == pytest.approx((0.64 + 4 / 9) / 2, rel=1e-6)
     # Kinect v2: corner pixel (0, 0): u = -255.5 / 256, v = -211.5 / 212 -> rho^2 = 0.9958
     kinect = radial_position(TofCamera(name="c", x=0, y=0, z=2).camera())
-    assert float(kinect[0, 0]) == pytest.approx(((255.5 / 256) ** 2 + (211.5 / 212) ** 2) / 2, rel=1e-6)
+    assert float(kinect[0, 0]) == pytest.approx(
+        ((255.5 / 256) ** 2 + (211.5 / 212) ** 2) / 2, rel=1e-6
+    )
 
 
 def test_noisy_depth_statistics_and_invalid_pixels() -> None:
-    spec = TofCamera(name="c", x=0, y=0, z=2, sigma_5m=0.005, off_centre_gain=0.0, random_dropout=0.0)
+    spec = TofCamera(
+        name="c", x=0, y=0, z=2, sigma_5m=0.005, off_centre_gain=0.0, random_dropout=0.0
+    )
     rng = np.random.default_rng(0)
     z = np.full((200, 200), 5.0, dtype=np.float32)
     z[0, 0] = np.nan  # nothing hit
@@ -100,10 +106,27 @@ def test_rig_renders_the_floor_at_the_expected_depth() -> None:
         {
             "name": "floor",
             "duration_s": 0.1,
-            "room": {"x_min": -3, "x_max": 3, "y_min": -3, "y_max": 3, "walls": False, "ceiling": False},
+            "room": {
+                "x_min": -3,
+                "x_max": 3,
+                "y_min": -3,
+                "y_max": 3,
+                "walls": False,
+                "ceiling": False,
+            },
         }
     )
-    spec = TofCamera(name="c", x=0, y=0, z=2.0, pitch_deg=90.0, width=64, height=48, sigma_5m=0.0, random_dropout=0.0)
+    spec = TofCamera(
+        name="c",
+        x=0,
+        y=0,
+        z=2.0,
+        pitch_deg=90.0,
+        width=64,
+        height=48,
+        sigma_5m=0.0,
+        random_dropout=0.0,
+    )
     frame = TofRig(scenario, [spec]).frame(0)
     depth = frame.images[0].depth
     # Looking straight down from 2 m: every pixel sees the floor at optical depth z = 2 m.

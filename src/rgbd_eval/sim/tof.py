@@ -30,7 +30,6 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from rgbd_eval.errors import ConfigError
-
 from rgbd_eval.sim.meshes import concatenate, rotation_y, rotation_z
 from rgbd_eval.sim.render import Hits, make_scene, overlay_hits, render_hits
 from rgbd_eval.sim.scenario import Scenario
