@@ -15,13 +15,16 @@ from __future__ import annotations
 import enum
 import math
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
 
+from rgbd_eval.config import ComponentConfig
 from rgbd_eval.detect.background import (
     BackgroundSubtractor,
     Mog2Background,
@@ -37,7 +40,14 @@ from rgbd_eval.detect.calibration import (
     world_floor_frame,
 )
 from rgbd_eval.detect.density import CameraMap, FloorGrid, camera_density, merge_maps
-from rgbd_eval.types import Box2D, CameraModel, Detection, Pose
+from rgbd_eval.plugins import (
+    DetectionContract,
+    DetectorSpec,
+    StreamSpec,
+    register_detector,
+    role_kind,
+)
+from rgbd_eval.types import Box2D, CameraModel, Detection, Frame, Pose
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
@@ -59,11 +69,10 @@ class FloorSource(enum.Enum):
     FIRST_FRAME = "first_frame"
 
 
-class DmtbsDetectorConfig(BaseModel):
+class DmtbsDetectorConfig(ComponentConfig):
     """The DMT-BS detector's parameters (values and reasons: configs/methods/dmtbs.yaml)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
-
+    name: Literal["dmtbs"] = "dmtbs"
     background: BackgroundMethod = Field(
         BackgroundMethod.RUNNING_AVERAGE, description="background subtractor (Fig. 10: mog2)"
     )
@@ -169,7 +178,24 @@ class DmtbsDetector:
         self._floor_T_world: Pose | None = None
         self._cameras: dict[str, _Camera] = {}
         self._last_ns: int | None = None
+        #: Seconds per stage, summed over the sequence (tests, in-memory runs).
         self.stage_seconds = dict.fromkeys(STAGES, 0.0)
+        self._last_timings: dict[str, float] = dict.fromkeys(STAGES, 0.0)
+
+    @property
+    def last_timings(self) -> Mapping[str, float]:
+        """Seconds of each stage of the last call."""
+        return self._last_timings
+
+    def detect(self, frame: Frame) -> list[Detection]:
+        """Detections from every depth stream of the frame (``depth``, ``depth_2``, ...)."""
+        roles = sorted((r for r in frame.streams if role_kind(r) == "depth"), key=_role_order)
+        views = []
+        for role in roles:
+            stream = frame.streams[role]
+            image = np.asarray(stream.image, dtype=np.float32)
+            views.append(DepthView(role, image, stream.camera, stream.pose))
+        return self.detect_views(frame.stamp_ns, views).detections
 
     def detect_views(self, stamp_ns: int, views: list[DepthView]) -> DensityResult:
         """Detections in the world frame from the synchronised depth images of all cameras."""
@@ -178,6 +204,7 @@ class DmtbsDetector:
         dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
         self._last_ns = stamp_ns
         cfg = self._cfg
+        timings = dict.fromkeys(STAGES, 0.0)
         maps: list[CameraMap] = []
         for view in views:
             cam = self._camera(view)
@@ -190,8 +217,8 @@ class DmtbsDetector:
                 )
             )
             t2 = time.perf_counter()
-            self.stage_seconds["background"] += t1 - t0
-            self.stage_seconds["density"] += t2 - t1
+            timings["background"] += t1 - t0
+            timings["density"] += t2 - t1
         t0 = time.perf_counter()
         density = merge_maps([m.density for m in maps])
         binary, blurred = blob_mask(
@@ -199,7 +226,10 @@ class DmtbsDetector:
         )
         blobs, labels = find_blobs(binary, blurred, self._grid)
         detections = self._detections(blobs, labels, maps)
-        self.stage_seconds["blobs"] += time.perf_counter() - t0
+        timings["blobs"] = time.perf_counter() - t0
+        self._last_timings = timings
+        for stage, seconds in timings.items():
+            self.stage_seconds[stage] += seconds
         return DensityResult(detections, density, labels)
 
     # ------------------------------------------------------------------ helpers
@@ -276,3 +306,28 @@ class DmtbsDetector:
                 )
             )
         return out
+
+
+def _role_order(role: str) -> int:
+    """``depth`` first, then ``depth_2``, ``depth_3``, ..."""
+    _, _, number = role.rpartition("_")
+    return int(number) if number.isdigit() else 1
+
+
+def _contract(config: DmtbsDetectorConfig) -> DetectionContract:
+    """Floor positions on the density map's grid, no image boxes, each blob's cells."""
+    return DetectionContract(world_position=True, box2d=False, position_resolution_m=config.cell_m)
+
+
+SPEC = register_detector(
+    DetectorSpec(
+        name="dmtbs",
+        config_model=DmtbsDetectorConfig,
+        factory=DmtbsDetector,
+        streams=(StreamSpec("depth", multiple=True),),
+        contract=_contract,
+        stages=STAGES,
+        summary="background subtraction, density map, blobs; 1..N static depth cameras "
+        "(seed 003, section 3)",
+    )
+)

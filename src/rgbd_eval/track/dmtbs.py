@@ -24,26 +24,30 @@ without one is a blob of one cell at its centroid.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+import time
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import Field
 
+from rgbd_eval.config import ComponentConfig
+from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import kalman
 from rgbd_eval.track.association import gnn_assign
 from rgbd_eval.track.blob_split import nearest_blob, split_centroids
 from rgbd_eval.track.motion import H, process_noise, transition_matrix
-from rgbd_eval.types import Detection, TrackOutput, TrackStatus, Visibility
+from rgbd_eval.types import Detection, Frame, TrackOutput, TrackStatus, Visibility
 
 F64 = NDArray[np.float64]
 
 
-class DmtbsTrackerConfig(BaseModel):
+class DmtbsTrackerConfig(ComponentConfig):
     """The DMT-BS tracker's parameters; the seed's table was lost, see configs/methods/dmtbs.yaml."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+    name: Literal["dmtbs"] = "dmtbs"
 
     gate_m: float = Field(1.0, gt=0.0, description="largest prediction-detection distance (m)")
     min_split_age_s: float = Field(
@@ -103,8 +107,14 @@ def _blob(det: Detection) -> _Blob:
 class DmtbsTracker:
     """Density-map blob tracking with blob splitting (seed 003); one instance per sequence."""
 
-    def __init__(self, config: DmtbsTrackerConfig) -> None:
+    def __init__(
+        self, config: DmtbsTrackerConfig, contract: DetectionContract | None = None
+    ) -> None:
+        problem = None if contract is None else check_contract(config, contract)
+        if problem is not None:
+            raise ValueError(problem)
         self._cfg = config
+        self._last_timings: dict[str, float] = {"tracking": 0.0}
         self._x = np.zeros((0, 4))
         self._P = np.zeros((0, 4, 4))
         self._tracks: list[_Track] = []
@@ -113,8 +123,21 @@ class DmtbsTracker:
         self._R = np.eye(2) * config.measurement_sigma_m**2
         self.splits = 0  # blobs split so far (for tests and reports)
 
-    def update(self, stamp_ns: int, detections: Sequence[Detection]) -> list[TrackOutput]:
+    @property
+    def last_timings(self) -> Mapping[str, float]:
+        """Seconds of the last :meth:`update`."""
+        return self._last_timings
+
+    def update(
+        self, stamp_ns: int, detections: Sequence[Detection], frame: Frame | None = None
+    ) -> list[TrackOutput]:
         """Consume one frame's detections; return every maintained track, ordered by id."""
+        t0 = time.perf_counter()
+        outputs = self._update(stamp_ns, detections)
+        self._last_timings = {"tracking": time.perf_counter() - t0}
+        return outputs
+
+    def _update(self, stamp_ns: int, detections: Sequence[Detection]) -> list[TrackOutput]:
         if self._last_ns is not None and stamp_ns <= self._last_ns:
             raise ValueError(f"stamp_ns={stamp_ns} must increase (previous frame: {self._last_ns})")
         dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
@@ -229,3 +252,22 @@ class DmtbsTracker:
                 )
             )
         return sorted(out, key=lambda o: o.track_id)
+
+
+def check_contract(config: DmtbsTrackerConfig, contract: DetectionContract) -> str | None:
+    """Why detections of ``contract`` cannot feed this tracker (None: they can)."""
+    if not contract.world_position:
+        return "dmtbs tracks floor positions, which these detections do not carry"
+    return None
+
+
+SPEC = register_tracker(
+    TrackerSpec(
+        name="dmtbs",
+        config_model=DmtbsTrackerConfig,
+        factory=DmtbsTracker,
+        check=check_contract,
+        stages=("tracking",),
+        summary="2D constant-velocity Kalman filters, Hungarian, blob splitting (seed 003, 3.3-3.4)",
+    )
+)
