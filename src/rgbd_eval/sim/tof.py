@@ -20,7 +20,7 @@ that a 5 m x 5 m scene is seen from its corners.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -30,6 +30,8 @@ from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.io.groundtruth import write_csv
+from rgbd_eval.io.writer import RecordingWriter, StreamOptions
 from rgbd_eval.sim.meshes import concatenate, rotation_y, rotation_z
 from rgbd_eval.sim.render import Hits, make_scene, overlay_hits, render_hits
 from rgbd_eval.sim.scenario import Scenario
@@ -41,6 +43,8 @@ F32 = NDArray[np.float32]
 
 #: Random stream of the ToF cameras' noise (apart from the Kinect v1 simulator's streams).
 _STREAM_TOF = 11
+#: The frame the cameras are placed in by /tf_static (the scenario's world, z up).
+WORLD_FRAME = "world"
 
 
 class TofCamera(BaseModel):
@@ -235,3 +239,68 @@ class TofRig:
     def frames(self) -> Iterator[TofFrame]:
         for i in range(self.n_frames):
             yield self.frame(i)
+
+
+def tof_topics(name: str) -> tuple[str, str]:
+    """A camera's depth image and CameraInfo topics."""
+    return f"/{name}/depth/image_raw", f"/{name}/depth/camera_info"
+
+
+@dataclass(frozen=True)
+class TofRecording:
+    """What :func:`write_tof_recording` wrote."""
+
+    path: Path
+    ground_truth: Path
+    frames: int
+
+
+def write_tof_recording(
+    rig: TofRig,
+    out_path: Path | str,
+    max_frames: int | None = None,
+    progress: Callable[[int, int], None] | None = None,
+) -> TofRecording:
+    """Render the rig's frames into a recording (see :func:`write_tof_frames`)."""
+    total = rig.n_frames if max_frames is None else min(rig.n_frames, max_frames)
+    if total < 1:
+        raise ValueError(f"max_frames={max_frames} must be at least 1")
+    frames = (rig.frame(i) for i in range(total))
+    return write_tof_frames(rig.cameras, frames, total, out_path, progress)
+
+
+def write_tof_frames(
+    cameras: list[TofCamera],
+    frames: Iterable[TofFrame],
+    total: int,
+    out_path: Path | str,
+    progress: Callable[[int, int], None] | None = None,
+) -> TofRecording:
+    """Write rendered frames as a depth-only multi-camera recording, plus ``<stem>.gt.csv``.
+
+    One depth topic per camera (16UC1 millimetres, like the Kinect v2), each with its
+    CameraInfo; the cameras placed in the ``world`` frame by /tf_static; ground truth on
+    ``/ground_truth`` and in the sidecar. The container follows the suffix (.bag, .mcap);
+    both files appear atomically.
+    """
+    out = Path(out_path)
+    truth: list[GroundTruthObject] = []
+    written = 0
+    with RecordingWriter(out, options=StreamOptions(depth_encoding="16UC1"), overwrite=True) as w:
+        for frame in frames:
+            if written == 0:
+                for spec in cameras:
+                    w.write_static_transform(
+                        frame.stamp_ns, WORLD_FRAME, spec.frame_id, spec.pose()
+                    )
+            for im in frame.images:
+                topic, info = tof_topics(im.name)
+                w.write_depth(frame.stamp_ns, im.depth, im.camera, topic=topic, info_topic=info)
+            w.write_ground_truth(frame.stamp_ns, WORLD_FRAME, frame.ground_truth)
+            truth.extend(frame.ground_truth)
+            written += 1
+            if progress is not None:
+                progress(written, total)
+    csv_path = out.with_name(out.stem + ".gt.csv")
+    write_csv(csv_path, truth)
+    return TofRecording(out, csv_path, written)
