@@ -25,7 +25,7 @@ SCENARIO = {
             "trousers": [30, 30, 30],
             "path": [{"x": 3.0, "y": 0.5}, {"x": 3.0, "y": -0.5, "speed": 1.0}],
         },
-    ],  # fmt: skip
+    ],
     "sensor": {"depth_decimation": 4},
     # 6 m ahead of the robot, 2.5 m up, looking back at the person, tilted 20 deg down
     "rig": [
@@ -40,7 +40,7 @@ SCENARIO = {
             "width": 128,
             "height": 106,
         },
-    ],  # fmt: skip
+    ],
 }
 
 
@@ -63,7 +63,8 @@ def test_static_depth_camera_sees_the_person_where_the_ground_truth_is(tmp_path:
     assert person.world_xyz is not None
     centre = cam.pose.inverse().transform_points(np.array([person.world_xyz]))
     (u, v), z = cam.camera.project(centre)[0], centre[0, 2]
-    seen = cam.image[int(round(v)) - 1 : int(round(v)) + 2, int(round(u)) - 1 : int(round(u)) + 2]
+    iu, iv = round(float(u)), round(float(v))
+    seen = cam.image[iv - 1 : iv + 2, iu - 1 : iu + 2]
     assert np.nanmin(seen) == pytest.approx(z, abs=0.35)
 
 
