@@ -26,7 +26,7 @@ from rgbd_eval.types import Detection, Frame, GroundTruthObject, TrackOutput
 Progress = Callable[[int, int], None]
 #: Stage names for what a detector's / tracker's call spends outside its named stages.
 DETECT_REST = "detections"
-TRACK_REST = "tracking"
+TRACK_REST = "track"
 
 
 @dataclass(frozen=True)
@@ -172,7 +172,7 @@ def detect_and_track(
     ``keep_appearance`` keeps them (for a replay of the tracker, as ``bench`` does).
     ``seconds`` of the result hold ``read``, ``detect`` and ``track`` and, as
     ``stage.<name>``, the detector's and tracker's own stages (the rest of their
-    calls as ``stage.detections`` and ``stage.tracking``): the figures of ``bench``.
+    calls as ``stage.detections`` and ``stage.track``): the figures of ``bench``.
     """
     seconds = {"read": 0.0, "detect": 0.0, "track": 0.0}
     stages: dict[str, float] = {}

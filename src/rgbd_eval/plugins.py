@@ -181,9 +181,13 @@ class _Registry:
 _REGISTRY = _Registry()
 
 
-def _add(table: dict[str, Any], kind: str, name: str, spec: Any) -> None:
+def _check_name(kind: str, name: str) -> None:
     if not name or not name.strip() or name != name.strip():
         raise ValueError(f"{kind} name must be a non-empty string without spaces, got {name!r}")
+
+
+def _add(table: dict[str, Any], kind: str, name: str, spec: Any) -> None:
+    _check_name(kind, name)
     existing = table.get(name)
     if existing is not None and existing != spec:
         raise ValueError(f"{kind} name {name!r} is already registered")
@@ -191,6 +195,7 @@ def _add(table: dict[str, Any], kind: str, name: str, spec: Any) -> None:
 
 
 def _check_model(kind: str, name: str, model: type[ComponentConfig]) -> None:
+    _check_name(kind, name)
     default = model.model_fields["name"].default
     if default != name:
         raise ValueError(

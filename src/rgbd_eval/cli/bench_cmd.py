@@ -34,7 +34,7 @@ STAGE_LABELS = {
     "features": "features",
     "hog": "HOG",
     "detections": "detector (rest of the call)",
-    "tracking": "tracking",
+    "track": "tracking",
     "score": "scoring",
     "other": "other (loop)",
 }

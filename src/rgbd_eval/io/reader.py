@@ -521,7 +521,15 @@ def open_recording(
             infos = [c.topic for c in conns if c.msgtype == CAMERA_INFO_TYPE]
             info_topics = {}
             for role, topic in chosen.items():
-                info_topic = _info_for(topic, infos, io.topic(f"{role}_info"))
+                named = io.topic(f"{role}_info")
+                if named is not None and named not in infos:
+                    raise TopicError(
+                        path,
+                        f"--topic {role}_info={named}: not a CameraInfo topic here "
+                        f"(candidates: {', '.join(sorted(infos)) or 'none'})",
+                        named,
+                    )
+                info_topic = _info_for(topic, infos, named)
                 if info_topic is not None:
                     info_topics[role] = info_topic
             odoms = [c.topic for c in conns if c.msgtype == ODOMETRY_TYPE]
