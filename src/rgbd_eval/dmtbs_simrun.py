@@ -52,6 +52,8 @@ def run_frames(
 ) -> RigRun:
     """Run DMT-BS on the named cameras of rendered frames and score with metric gating.
 
+    Every present person is ground truth (:class:`~rgbd_eval.sim.tof.TofRig`).
+
     ``pose_errors_deg`` gives a camera the extrinsic yaw error of Fig. 11: the detector
     believes the camera is rotated by that angle about the vertical.
     """

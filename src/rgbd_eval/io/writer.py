@@ -319,24 +319,13 @@ class RecordingWriter:
             self.camera_info(stamp_ns, camera, RGB_INFO_TOPIC),
         )
 
-    def write_depth(
-        self,
-        stamp_ns: int,
-        depth: NDArray[np.floating],
-        camera: CameraModel,
-        topic: str | None = None,
-        info_topic: str = DEPTH_INFO_TOPIC,
-    ) -> None:
-        """The depth image (metres, NaN invalid) in the configured encoding, and its CameraInfo.
-
-        ``topic`` defaults to the options' depth topic; a rig of several depth cameras
-        gives each its own ``topic`` and ``info_topic``.
-        """
+    def write_depth(self, stamp_ns: int, depth: NDArray[np.floating], camera: CameraModel) -> None:
+        """The depth image (metres, NaN invalid) in the configured encoding, and its CameraInfo."""
         if depth.shape != (camera.height, camera.width):
             raise ValueError(
                 f"depth image shape {depth.shape} does not match camera {camera.width}x{camera.height}"
             )
-        topic = self.options.depth_topic if topic is None else topic
+        topic = self.options.depth_topic
         header = self.header(stamp_ns, camera.frame_id, topic)
         if self.options.depth_compressed:
             fields = images.encode_depth_compressed(depth, self.options.depth_encoding)
@@ -348,7 +337,10 @@ class RecordingWriter:
             )
             self.write_message(topic, IMAGE_TYPE, stamp_ns, msg)
         self.write_message(
-            info_topic, CAMERA_INFO_TYPE, stamp_ns, self.camera_info(stamp_ns, camera, info_topic)
+            DEPTH_INFO_TOPIC,
+            CAMERA_INFO_TYPE,
+            stamp_ns,
+            self.camera_info(stamp_ns, camera, DEPTH_INFO_TOPIC),
         )
 
     def write_image(
