@@ -15,21 +15,21 @@ from rgbd_eval.detect.dmtbs import (
     DmtbsDetectorConfig,
     FloorSource,
 )
-from rgbd_eval.sim.tof import TofCamera
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
 from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
 
 METHOD_FILE = Path(__file__).parents[2] / "configs" / "methods" / "dmtbs.yaml"
 STEP = 33_333_333
 
 
-def _overhead(name: str, x: float, y: float) -> tuple[TofCamera, np.ndarray]:
+def _overhead(name: str, x: float, y: float) -> tuple[StaticDepthCamera, np.ndarray]:
     """A 64x48 camera 3 m above (x, y) looking straight down, and its empty-floor depth."""
-    spec = TofCamera(name=name, x=x, y=y, z=3.0, pitch_deg=90.0, width=64, height=48)
-    return spec, np.full((48, 64), 3.0, dtype=np.float32)
+    cfg = StaticDepthConfig(name=name, x=x, y=y, z=3.0, pitch_deg=90.0, width=64, height=48)
+    return StaticDepthCamera(cfg, "world"), np.full((48, 64), 3.0, dtype=np.float32)
 
 
-def _views(specs: list[TofCamera], depths: list[np.ndarray]) -> list[DepthView]:
-    return [DepthView(s.name, d, s.camera(), s.pose()) for s, d in zip(specs, depths, strict=True)]
+def _views(cams: list[StaticDepthCamera], depths: list[np.ndarray]) -> list[DepthView]:
+    return [DepthView(c.cfg.name, d, c.camera, c.pose) for c, d in zip(cams, depths, strict=True)]
 
 
 def _with_box(floor: np.ndarray) -> np.ndarray:
@@ -39,11 +39,11 @@ def _with_box(floor: np.ndarray) -> np.ndarray:
     return d
 
 
-def _box_xy(spec: TofCamera) -> np.ndarray:
+def _box_xy(cam: StaticDepthCamera) -> np.ndarray:
     """World (x, y) of the box-top pixels' mean, by back-projection."""
-    pts = spec.camera().backproject(_with_box(np.full((48, 64), np.nan, dtype=np.float32)))
+    pts = cam.camera.backproject(_with_box(np.full((48, 64), np.nan, dtype=np.float32)))
     p = pts[22:28, 30:36].reshape(-1, 3)
-    return spec.pose().transform_points(p)[:, :2].mean(axis=0)
+    return cam.pose.transform_points(p)[:, :2].mean(axis=0)
 
 
 def test_one_camera_one_box() -> None:

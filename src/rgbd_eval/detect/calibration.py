@@ -6,7 +6,7 @@ recording's tf, or from a calibration YAML). Both combine into ``floor_T_optical
 camera: floor coordinates have x, y on the floor and z the height above it, so the density
 map bins x, y and the 1 m height cut reads z.
 
-Calibration YAML (``--calibration``), poses ``world_T_optical`` with ROS quaternions::
+Calibration YAML (``detector.calibration``), poses ``world_T_optical`` with ROS quaternions::
 
     cameras:
       cam0_depth_optical_frame: {translation: [0.0, -2.5, 2.6], rotation: [x, y, z, w]}
