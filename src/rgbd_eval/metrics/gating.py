@@ -114,3 +114,44 @@ def distance_matrix(
 def similarity(gating: Gating, distance: float) -> float:
     """What MOTP averages for one match: IoU (``1 - distance``) or the distance in metres."""
     return 1.0 - distance if gating is Gating.IOU else distance
+
+
+#: Float tolerance of TrackEval's comparisons (``np.finfo("float").eps``).
+EPS = float(np.finfo(np.float64).eps)
+
+
+def measure_matrix(gating: Gating, gt_values: ArrayLike, track_values: ArrayLike) -> FloatArray:
+    """Ungated IoU (IoU gating) or ground-plane distance in metres (metric gating)."""
+    if gating is Gating.IOU:
+        return iou_matrix(gt_values, track_values)
+    return ground_distance_matrix(gt_values, track_values)
+
+
+def similarity_from_measure(gating: Gating, measure: FloatArray, threshold: float) -> FloatArray:
+    """TrackEval's similarity in [0, 1]: IoU, or ``max(0, 1 - d / (2 threshold))``.
+
+    The distance form is TrackEval's Euclidean similarity with its zero distance set
+    to twice the gate, so that similarity 0.5 is exactly the gate distance (TrackEval's
+    default zero distance of 2 m for the default 1 m gate). HOTA and the
+    ``motchallenge`` matching use this similarity.
+    """
+    if gating is Gating.IOU:
+        return measure
+    return np.maximum(0.0, 1.0 - measure / (2.0 * threshold))
+
+
+def similarity_threshold(gating: Gating, threshold: float) -> float:
+    """The similarity a ``motchallenge`` match needs: the IoU threshold, or 0.5 for distances."""
+    return threshold if gating is Gating.IOU else 0.5
+
+
+def gate(
+    gating: Gating, measure: FloatArray, similarity: FloatArray, threshold: float, exact_trackeval: bool
+) -> NDArray[np.bool_]:
+    """Which pairs may match: TrackEval's ``similarity >= t - eps``, or motmetrics' plain test."""
+    if exact_trackeval:
+        out: NDArray[np.bool_] = similarity >= similarity_threshold(gating, threshold) - EPS
+        return out
+    if gating is Gating.IOU:
+        return measure >= threshold
+    return measure <= threshold
