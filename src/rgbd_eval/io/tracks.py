@@ -157,7 +157,9 @@ def read_mot_tracks(path: Path) -> TrackerOutput:
 def _mot_benchmark(rows: np.ndarray, benchmark: Benchmark) -> Benchmark:
     if benchmark is not Benchmark.AUTO:
         return benchmark
-    has_classes = rows.size and rows.shape[1] >= 8 and bool((rows[:, 7] >= 1).all())
+    # MOT16/17/20 ground truth has 9 columns (class and visibility in 8 and 9); MOT15 has
+    # 10 (world x, y, z in 8-10, -1 when unknown).
+    has_classes = bool(rows.size) and rows.shape[1] == 9 and bool((rows[:, 7] >= 1).all())
     return Benchmark.MOT17 if has_classes else Benchmark.MOT15
 
 
@@ -172,6 +174,9 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
     for row in rows:
         frame, oid = int(row[0]), int(row[1])
         ignore, distractor, visibility = False, True, 1.0
+        world = None
+        if rules is Benchmark.MOT15 and row.shape[0] >= 10 and not np.all(row[7:10] == -1):
+            world = (float(row[7]), float(row[8]), float(row[9]))
         if rules is not Benchmark.MOT15:
             cls = int(row[7])
             scored = cls == _PEDESTRIAN and row[6] != 0
@@ -185,7 +190,7 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
                 stamp_ns=0,
                 object_id=oid,
                 box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
-                world_xyz=None,
+                world_xyz=world,
                 visibility=visibility,
                 ignore=ignore,
                 distractor=distractor,
