@@ -182,7 +182,9 @@ def test_metric_and_iou_gating_match_differently() -> None:
     for scores in (by_iou, by_distance):
         assert (scores.counts.fp, scores.counts.fn) == (1, 1)
     # A wider metric gate (2 m) matches both.
-    wide = evaluate_sequence(gts, tracks, EvaluationConfig(gating=Gating.METRIC, threshold=2.0, convention=MM))
+    wide = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=Gating.METRIC, threshold=2.0, convention=MM)
+    )
     assert wide.counts.num_matches == 2
     assert wide.summary()["motp"] == pytest.approx(1.0)  # (0.5 + 1.5) / 2
 

@@ -213,7 +213,9 @@ def test_a_perfect_tracker_scores_mota_one(
         ]
         for frame in gts
     ]
-    s = evaluate_sequence(gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)).summary()
+    s = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)
+    ).summary()
     if s["num_gt"] == 0:
         assert s["mota"] is None
         return
@@ -228,7 +230,9 @@ def test_a_perfect_tracker_scores_mota_one(
 @given(data=sequences(with_ignored=True))
 def test_ignored_ground_truth_is_neither_scored_nor_missed(gating: Gating, data: Frames) -> None:
     gts, tracks = data
-    scores = evaluate_sequence(gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS))
+    scores = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)
+    )
     c = scores.counts
     ignored = sum(g.ignore for frame in gts for g in frame)
     scored_tracks = sum(_scored(t) for frame in tracks for t in frame)

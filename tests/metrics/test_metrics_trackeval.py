@@ -58,14 +58,20 @@ def sequences(draw: st.DrawFn) -> Frames:
     return gts, tracks
 
 
-def _trackeval_data(gts: list[list[GroundTruthObject]], tracks: list[list[TrackOutput]], gating: Gating) -> dict[str, object]:
+def _trackeval_data(
+    gts: list[list[GroundTruthObject]], tracks: list[list[TrackOutput]], gating: Gating
+) -> dict[str, object]:
     """TrackEval's per-sequence ``data`` dict, ids relabelled densely as its datasets do."""
     gt_map: dict[int, int] = {}
     tr_map: dict[int, int] = {}
     gt_ids, tr_ids, sims = [], [], []
     for frame_gt, frame_tr in zip(gts, tracks, strict=True):
-        gt_ids.append(np.array([gt_map.setdefault(g.object_id, len(gt_map)) for g in frame_gt], dtype=int))
-        tr_ids.append(np.array([tr_map.setdefault(t.track_id, len(tr_map)) for t in frame_tr], dtype=int))
+        gt_ids.append(
+            np.array([gt_map.setdefault(g.object_id, len(gt_map)) for g in frame_gt], dtype=int)
+        )
+        tr_ids.append(
+            np.array([tr_map.setdefault(t.track_id, len(tr_map)) for t in frame_tr], dtype=int)
+        )
         if gating is Gating.IOU:
             a = np.array([g.box2d.as_tuple() for g in frame_gt if g.box2d]).reshape(-1, 4)
             b = np.array([t.box2d.as_tuple() for t in frame_tr if t.box2d]).reshape(-1, 4)

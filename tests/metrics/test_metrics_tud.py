@@ -24,9 +24,57 @@ DATA = Path(mm.__file__).parent / "data"
 # motmetrics' test_motchallenge_files: idf1, idp, idr, recall, precision, GT tracks, MT, PT,
 # ML, FP, FN, IDsw, Frag, MOTA, MOTP (mean 1 - IoU), per sequence and overall.
 EXPECTED = {
-    "TUD-Campus": (0.557659, 0.729730, 0.451253, 0.582173, 0.941441, 8, 1, 6, 1, 13, 150, 7, 7, 0.526462, 0.277201),
-    "TUD-Stadtmitte": (0.644619, 0.819760, 0.531142, 0.608997, 0.939920, 10, 5, 4, 1, 45, 452, 7, 6, 0.564014, 0.345904),
-    "overall": (0.624296, 0.799176, 0.512211, 0.602640, 0.940268, 18, 6, 10, 2, 58, 602, 14, 13, 0.555116, 0.330177),
+    "TUD-Campus": (
+        0.557659,
+        0.729730,
+        0.451253,
+        0.582173,
+        0.941441,
+        8,
+        1,
+        6,
+        1,
+        13,
+        150,
+        7,
+        7,
+        0.526462,
+        0.277201,
+    ),
+    "TUD-Stadtmitte": (
+        0.644619,
+        0.819760,
+        0.531142,
+        0.608997,
+        0.939920,
+        10,
+        5,
+        4,
+        1,
+        45,
+        452,
+        7,
+        6,
+        0.564014,
+        0.345904,
+    ),
+    "overall": (
+        0.624296,
+        0.799176,
+        0.512211,
+        0.602640,
+        0.940268,
+        18,
+        6,
+        10,
+        2,
+        58,
+        602,
+        14,
+        13,
+        0.555116,
+        0.330177,
+    ),
 }
 
 
@@ -45,8 +93,15 @@ def test_tud_equals_motmetrics_expected_values(name: str) -> None:
     else:
         c = _score(name, Convention.MOTMETRICS)
     s = summarize(c)
-    idf1, idp, idr, recall, precision, n_gt, mt, pt, ml, fp, fn, idsw, frag, mota, motp = EXPECTED[name]
-    assert (c.num_gt_tracks, c.mostly_tracked, c.partly_tracked, c.mostly_lost) == (n_gt, mt, pt, ml)
+    idf1, idp, idr, recall, precision, n_gt, mt, pt, ml, fp, fn, idsw, frag, mota, motp = EXPECTED[
+        name
+    ]
+    assert (c.num_gt_tracks, c.mostly_tracked, c.partly_tracked, c.mostly_lost) == (
+        n_gt,
+        mt,
+        pt,
+        ml,
+    )
     assert (c.fp, c.fn, c.id_switches, c.fragmentations) == (fp, fn, idsw, frag)
     for ours, theirs in (
         (s["idf1"], idf1),
@@ -70,7 +125,9 @@ def test_tud_equals_trackeval(name: str) -> None:
     tr_map: dict[int, int] = {}
     gt_ids, tr_ids, sims = [], [], []
     for fg, ft in zip(aligned.gt, aligned.tracks, strict=True):
-        gt_ids.append(np.array([gt_map.setdefault(g.object_id, len(gt_map)) for g in fg], dtype=int))
+        gt_ids.append(
+            np.array([gt_map.setdefault(g.object_id, len(gt_map)) for g in fg], dtype=int)
+        )
         tr_ids.append(np.array([tr_map.setdefault(t.track_id, len(tr_map)) for t in ft], dtype=int))
         a = np.array([g.box2d.as_tuple() for g in fg if g.box2d]).reshape(-1, 4)
         b = np.array([t.box2d.as_tuple() for t in ft if t.box2d]).reshape(-1, 4)

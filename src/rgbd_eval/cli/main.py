@@ -10,6 +10,7 @@ from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.reproduce_cmd import reproduce
 from rgbd_eval.cli.run import run
+from rgbd_eval.cli.score_cmd import score
 from rgbd_eval.cli.sweep_cmd import sweep
 from rgbd_eval.cli.synth_cmd import synth
 
@@ -28,6 +29,7 @@ app.command("compare")(compare)
 app.command("synth")(synth)
 app.command("reproduce")(reproduce)
 app.command("bench")(bench)
+app.command("score")(score)
 
 
 def _version(value: bool) -> None:

@@ -23,7 +23,6 @@ import configparser
 import csv
 import enum
 import math
-from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -67,6 +66,7 @@ class Aligned:
     """Ground truth and tracks on one timeline, ready for ``evaluate_sequence``."""
 
     stamps_ns: tuple[int, ...]
+    frame_numbers: tuple[int, ...]
     gt: list[list[GroundTruthObject]]
     tracks: list[list[TrackOutput]]
     unmatched_track_frames: int
@@ -108,9 +108,17 @@ def _mot_rows(path: Path, what: type[Exception]) -> np.ndarray:
         rows = np.loadtxt(path, delimiter=",", ndmin=2, dtype=np.float64)
     except (OSError, ValueError) as err:
         message = f"not MOTChallenge text ({err})"
-        raise (GroundTruthError(path, message) if what is GroundTruthError else InputError(path, message)) from err
+        raise (
+            GroundTruthError(path, message)
+            if what is GroundTruthError
+            else InputError(path, message)
+        ) from err
     if rows.size and rows.shape[1] < 6:
-        raise (what(path, "MOTChallenge text needs at least 6 columns") if what is not GroundTruthError else GroundTruthError(path, "MOTChallenge text needs at least 6 columns"))
+        raise (
+            what(path, "MOTChallenge text needs at least 6 columns")
+            if what is not GroundTruthError
+            else GroundTruthError(path, "MOTChallenge text needs at least 6 columns")
+        )
     if rows.size and not np.isfinite(rows[:, :6]).all():
         raise InputError(path, "non-finite frame, id or box value")
     return rows
@@ -232,7 +240,9 @@ def read_tracks_csv(path: Path) -> TrackerOutput:
                         track_id=int(row["id"]),
                         x=float(row["x"]),
                         y=float(row["y"]),
-                        height=height if height is not None else (2 * z if z is not None else math.nan),
+                        height=height
+                        if height is not None
+                        else (2 * z if z is not None else math.nan),
                         box2d=None if any(v is None for v in box) else Box2D(*box),  # type: ignore[arg-type]
                         visibility=Visibility[(row.get("visibility") or "visible").upper()],
                         status=TrackStatus(row.get("status") or "validated"),
@@ -304,9 +314,7 @@ def load_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> tuple[GroundTr
 # ----------------------------------------------------------------------------- alignment
 
 
-def _by_frame_number(
-    gt: GroundTruth, tracks: TrackerOutput, length: int | None
-) -> Aligned:
+def _by_frame_number(gt: GroundTruth, tracks: TrackerOutput, length: int | None) -> Aligned:
     gt_frames = {f: list(objs) for f, _, objs in gt.frames}
     track_frames = {f: list(t) for f, _, t in tracks.frames}
     numbers = set(gt_frames) | set(track_frames)
@@ -315,6 +323,7 @@ def _by_frame_number(
     timeline = range(first, last + 1) if numbers or length else range(0)
     return Aligned(
         stamps_ns=tuple(0 for _ in timeline),
+        frame_numbers=tuple(timeline),
         gt=[gt_frames.get(f, []) for f in timeline],
         tracks=[track_frames.get(f, []) for f in timeline],
         unmatched_track_frames=0,
@@ -349,6 +358,7 @@ def align(
             unmatched += 1
     return Aligned(
         stamps_ns=tuple(int(s) for s in stamps),
+        frame_numbers=tuple(f for f, _, _ in gt.frames),
         gt=[list(objs) for _, _, objs in gt.frames],
         tracks=out,
         unmatched_track_frames=unmatched,
@@ -374,10 +384,17 @@ def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
     pairs = []
     for f in files:
         name = _name(f)
-        options = (gt / name / "gt" / "gt.txt", gt / f"{name}.gt.csv", gt / f"{name}.txt", gt / f"{name}.csv")
+        options = (
+            gt / name / "gt" / "gt.txt",
+            gt / f"{name}.gt.csv",
+            gt / f"{name}.txt",
+            gt / f"{name}.csv",
+        )
         found = next((o for o in options if o.is_file()), None)
         if found is None:
-            raise GroundTruthError(gt, f"no ground truth for sequence {name!r} (tried {options[0].name}, ...)")
+            raise GroundTruthError(
+                gt, f"no ground truth for sequence {name!r} (tried {options[0].name}, ...)"
+            )
         pairs.append((name, f, found))
     return pairs
 
@@ -388,7 +405,3 @@ def _name(path: Path) -> str:
         if name.endswith(suffix):
             return name[: -len(suffix)]
     return path.stem
-
-
-def _unused(_: Iterable[Sequence[object]]) -> None:
-    return None

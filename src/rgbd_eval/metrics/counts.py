@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, field, fields
 
 from rgbd_eval.config import Convention, Gating
 from rgbd_eval.metrics.gating import check_threshold
@@ -90,7 +90,7 @@ class Counts:
     recall_errors: int = 0
     ignored_gt: int = 0
     ignored_tracks: int = 0
-    hota: HotaCounts = HotaCounts()
+    hota: HotaCounts = field(default_factory=HotaCounts)
 
     def __post_init__(self) -> None:
         if not isinstance(self.gating, Gating):

@@ -146,7 +146,11 @@ def similarity_threshold(gating: Gating, threshold: float) -> float:
 
 
 def gate(
-    gating: Gating, measure: FloatArray, similarity: FloatArray, threshold: float, exact_trackeval: bool
+    gating: Gating,
+    measure: FloatArray,
+    similarity: FloatArray,
+    threshold: float,
+    exact_trackeval: bool,
 ) -> NDArray[np.bool_]:
     """Which pairs may match: TrackEval's ``similarity >= t - eps``, or motmetrics' plain test."""
     if exact_trackeval:

@@ -69,13 +69,16 @@ class HotaCounts:
         names = ("tp", "fn", "fp", "ass_sum", "loc_sum")
         if not isinstance(data, dict) or set(data) != set(names):
             raise ValueError(f"counts: hota must be an object with keys {list(names)}")
-        values = []
         for n in names:
-            items = data[n]
-            if not isinstance(items, list):
+            if not isinstance(data[n], list):
                 raise ValueError(f"counts: hota.{n} must be a list")
-            values.append(tuple(float(v) if n.endswith("_sum") else v for v in items))
-        return HotaCounts(*values)
+        return HotaCounts(
+            tp=tuple(data["tp"]),
+            fn=tuple(data["fn"]),
+            fp=tuple(data["fp"]),
+            ass_sum=tuple(float(v) for v in data["ass_sum"]),
+            loc_sum=tuple(float(v) for v in data["loc_sum"]),
+        )
 
     def summary(self) -> dict[str, float | None]:
         """HOTA, DetA, AssA, LocA averaged over the alphas (None when nothing was scored)."""

@@ -141,10 +141,8 @@ class MotMetricsMatcher:
         self, gt: IntArray, tracks: IntArray, distance: FloatArray, valid: BoolArray
     ) -> FrameMatch:
         """Match one frame; ``distance`` is what motmetrics minimises (1 - IoU, or metres)."""
-        if len(gt) == 0 or len(tracks) == 0:
-            match = EMPTY_MATCH
-        else:
-            match = self._match(gt, tracks, distance, valid)
+        empty = len(gt) == 0 or len(tracks) == 0
+        match = EMPTY_MATCH if empty else self._match(gt, tracks, distance, valid)
         self._count_fragments(gt, match.rows)
         return match
 

@@ -173,7 +173,9 @@ def select_frame(
             gt_ids, gt_values, track_ids, track_values, measure, ignored_ids, [], present
         )
     # All ground truth of the frame, in input order, against the scored tracks.
-    joined = [g for g, ign in zip(gt_objects, ignored_flags, strict=True) if not ign or _has(g, gating)]
+    joined = [
+        g for g, ign in zip(gt_objects, ignored_flags, strict=True) if not ign or _has(g, gating)
+    ]
     _, joined_values = _gt_values(frame, joined, gating, required=False)
     joined_measure = measure_matrix(gating, joined_values, track_values)
     similarity = similarity_from_measure(gating, joined_measure, threshold)
