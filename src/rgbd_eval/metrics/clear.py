@@ -113,8 +113,14 @@ def evaluate_sequence(
     return score_selections(selections, config)
 
 
-def _dense(ids: list[int], index: dict[int, int]) -> IntArray:
-    return np.array([index.setdefault(i, len(index)) for i in ids], dtype=np.int64)
+def _dense(per_frame: Sequence[Sequence[int]]) -> tuple[list[IntArray], int]:
+    """Per-frame ids as dense indices ``0..K-1`` (in sorted id order), and ``K``."""
+    flat = np.fromiter(
+        (i for ids in per_frame for i in ids), dtype=np.int64, count=sum(map(len, per_frame))
+    )
+    unique, inverse = np.unique(flat, return_inverse=True)
+    bounds = np.cumsum([len(ids) for ids in per_frame])[:-1]
+    return np.split(inverse.astype(np.int64), bounds), len(unique)
 
 
 def score_selections(
@@ -125,12 +131,13 @@ def score_selections(
     threshold = config.effective_threshold()
     if not selections:
         return SequenceScores(Counts.empty(gating, threshold, convention), ())
-    gt_index: dict[int, int] = {}
-    track_index: dict[int, int] = {}
-    gts = [_dense(s.gt_ids, gt_index) for s in selections]
-    tracks = [_dense(s.track_ids, track_index) for s in selections]
-    present = [_dense(sorted(s.present_track_ids), track_index) for s in selections]
-    num_gt, num_tracks = len(gt_index), len(track_index)
+    gts, num_gt = _dense([s.gt_ids for s in selections])
+    # Present tracks include the dropped ones; the scored tracks are their subset.
+    n = len(selections)
+    both, num_tracks = _dense(
+        [s.track_ids for s in selections] + [sorted(s.present_track_ids) for s in selections]
+    )
+    tracks, present = both[:n], both[n:]
     trackeval = convention is Convention.MOTCHALLENGE
     mc = MotChallengeMatcher(num_gt)
     mm = MotMetricsMatcher(num_gt, num_tracks)
@@ -239,14 +246,13 @@ def _frame_events(
     return FrameEvents(
         frame=index,
         matches=tuple(
-            Match(sel.gt_ids[r], sel.track_ids[c], v, s, e)
-            for r, c, v, s, e in zip(
-                rows.tolist(),
-                cols.tolist(),
+            map(
+                Match,
+                [sel.gt_ids[r] for r in rows.tolist()],
+                [sel.track_ids[c] for c in cols.tolist()],
                 values.tolist(),
                 switch.tolist(),
                 recall.tolist(),
-                strict=True,
             )
         ),
         misses=tuple(x for k, x in enumerate(sel.gt_ids) if k not in matched_rows),

@@ -24,6 +24,8 @@ from rgbd_eval.config import Gating
 
 FloatArray = NDArray[np.float64]
 
+#: Float tolerance of TrackEval's comparisons (``np.finfo("float").eps``).
+EPS = float(np.finfo(np.float64).eps)
 #: IoU a match needs by default: the PASCAL criterion (seed 000, 7.3).
 DEFAULT_IOU_THRESHOLD = 0.5
 #: Ground-plane distance (m) a match may have by default (seed 001, V-B).
@@ -52,18 +54,29 @@ def iou_matrix(gt_boxes: ArrayLike, track_boxes: ArrayLike) -> FloatArray:
     """Intersection over union of every ground-truth box with every track box.
 
     Both inputs are ``(N, 4)`` / ``(M, 4)`` arrays of ``(left, top, width, height)``;
-    the result is ``(N, M)`` in ``[0, 1]``. Two boxes whose union has zero area
-    have IoU 0.
+    the result is ``(N, M)`` in ``[0, 1]``. The arithmetic is TrackEval's
+    (``_calculate_box_ious``, corners first, areas from the corners), so that the
+    values are bit for bit the ones the devkit convention is defined on; a box of
+    zero area has IoU 0 with everything.
     """
-    a = _as_boxes(gt_boxes, "gt_boxes")[:, None, :]
-    b = _as_boxes(track_boxes, "track_boxes")[None, :, :]
-    near = np.maximum(a[..., :2], b[..., :2])  # (N, M, 2): max of left and of top edges
-    far = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])  # min right, bottom
-    overlap = np.maximum(far - near, 0.0)
-    intersection = overlap[..., 0] * overlap[..., 1]
-    union = a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - intersection
-    # A zero union means two zero-area boxes, whose intersection is 0 as well.
-    iou: FloatArray = intersection / np.where(union > 0.0, union, 1.0)
+    a = _as_boxes(gt_boxes, "gt_boxes")
+    b = _as_boxes(track_boxes, "track_boxes")
+    ax0, ay0 = a[:, 0:1], a[:, 1:2]
+    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
+    bx0, by0 = b[:, 0], b[:, 1]
+    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    width = np.maximum(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0)
+    height = np.maximum(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0)
+    intersection = width * height
+    area_a = (ax1 - ax0) * (ay1 - ay0)
+    area_b = (bx1 - bx0) * (by1 - by0)
+    union = area_a + area_b - intersection
+    intersection[(area_a <= EPS)[:, 0], :] = 0.0
+    intersection[:, area_b <= EPS] = 0.0
+    degenerate = union <= EPS
+    intersection[degenerate] = 0.0
+    union[degenerate] = 1.0
+    iou: FloatArray = intersection / union
     return iou
 
 
@@ -114,10 +127,6 @@ def distance_matrix(
 def similarity(gating: Gating, distance: float) -> float:
     """What MOTP averages for one match: IoU (``1 - distance``) or the distance in metres."""
     return 1.0 - distance if gating is Gating.IOU else distance
-
-
-#: Float tolerance of TrackEval's comparisons (``np.finfo("float").eps``).
-EPS = float(np.finfo(np.float64).eps)
 
 
 def measure_matrix(gating: Gating, gt_values: ArrayLike, track_values: ArrayLike) -> FloatArray:
