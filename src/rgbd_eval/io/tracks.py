@@ -289,9 +289,29 @@ def read_ktp_tracks(path: Path) -> TrackerOutput:
     return TrackerOutput(str(path), frames)
 
 
-def load_tracks(path: Path) -> TrackerOutput:
-    """Tracker output from a file, its format detected from the content."""
+RECORDING_SUFFIXES = (".bag", ".mcap", ".db3")
+
+
+def is_recording(path: Path) -> bool:
+    """Whether ``path`` is a ROS1 bag, an MCAP/db3 file or a ROS2 bag folder."""
+    return (path.is_file() and path.suffix in RECORDING_SUFFIXES) or (
+        path.is_dir() and (path / "metadata.yaml").is_file()
+    )
+
+
+def load_tracks(
+    path: Path, topic: str | None = None, world_frame: str | None = None
+) -> TrackerOutput:
+    """Tracker output from a file or recording, its format detected from the content.
+
+    ``topic`` and ``world_frame`` apply to recordings (see
+    :mod:`rgbd_eval.io.track_messages`).
+    """
     path = Path(path)
+    if is_recording(path):
+        from rgbd_eval.io.track_messages import read_bag_tracks
+
+        return read_bag_tracks(path, topic, world_frame)
     if not path.is_file():
         raise InputError(path, "tracker output not found")
     if is_mot_text(path):
@@ -372,15 +392,19 @@ def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
     first of ``GT/<name>/gt/gt.txt``, ``GT/<name>.gt.csv``, ``GT/<name>.txt``,
     ``GT/<name>.csv`` that exists.
     """
-    if not tracks.is_dir():
+    if not tracks.is_dir() or is_recording(tracks):
         if gt.is_dir():
             raise GroundTruthError(gt, "a folder of ground truth needs a folder of tracker output")
         return [(_name(tracks), tracks, gt)]
     if not gt.is_dir():
         raise GroundTruthError(gt, "a folder of tracker output needs a folder of ground truth")
-    files = sorted(p for p in tracks.iterdir() if p.is_file() and p.suffix in (".txt", ".csv"))
+    files = sorted(
+        p
+        for p in tracks.iterdir()
+        if (p.is_file() and p.suffix in (".txt", ".csv")) or is_recording(p)
+    )
     if not files:
-        raise InputError(tracks, "folder holds no tracker output (.txt or .csv)")
+        raise InputError(tracks, "folder holds no tracker output (.txt, .csv or recordings)")
     pairs = []
     for f in files:
         name = _name(f)
@@ -401,7 +425,7 @@ def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
 
 def _name(path: Path) -> str:
     name = path.name
-    for suffix in (".tracks.csv", ".csv", ".txt"):
+    for suffix in (".tracks.csv", ".csv", ".txt", *RECORDING_SUFFIXES):
         if name.endswith(suffix):
             return name[: -len(suffix)]
     return path.stem
