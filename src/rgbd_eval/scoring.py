@@ -50,10 +50,15 @@ def score_sequence(
     config: EvaluationConfig,
     max_gap_ns: int,
     benchmark: Benchmark = Benchmark.AUTO,
+    topic: str | None = None,
+    world_frame: str | None = None,
 ) -> ScoredSequence:
-    """Read, align and score one sequence; ScoringError when nothing can be compared."""
+    """Read, align and score one sequence; ScoringError when nothing can be compared.
+
+    ``topic`` and ``world_frame`` apply to tracks recorded in a bag.
+    """
     gt, length = load_gt(gt_path, benchmark)
-    tracks = load_tracks(tracks_path)
+    tracks = load_tracks(tracks_path, topic, world_frame)
     aligned = align(gt, tracks, max_gap_ns, length)
     if tracks.frames and aligned.unmatched_track_frames == len(tracks.frames) and gt.frames:
         raise ScoringError(

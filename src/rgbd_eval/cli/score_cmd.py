@@ -18,7 +18,10 @@ from rgbd_eval.errors import ConfigError
 @handle_errors
 def score(
     tracks: Annotated[
-        Path, typer.Argument(help="tracker output (MOTChallenge .txt, tracks.csv, KTP) or a folder")
+        Path,
+        typer.Argument(
+            help="tracker output (MOTChallenge .txt, tracks.csv, KTP, a bag with tracks) or a folder"
+        ),
     ],
     gt: Annotated[
         Path, typer.Option(help="ground truth (MOTChallenge gt.txt, CSV sidecar, KTP) or a folder")
@@ -37,6 +40,9 @@ def score(
         str,
         typer.Option(help="MOTChallenge ground-truth rules: auto, mot15, mot16, mot17, mot20"),
     ] = "auto",
+    tracks_topic: Annotated[
+        str | None, typer.Option(help="topic of the tracks in a bag (when there are several)")
+    ] = None,
     config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
     overrides: Annotated[
         list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
@@ -64,7 +70,9 @@ def score(
         raise ConfigError(f"--benchmark {benchmark!r}: expected one of {known}") from err
     max_gap_ns = int(config.io.max_sync_gap_ms * 1e6)
     sequences = [
-        score_sequence(name, t, g, config.evaluation, max_gap_ns, rules)
+        score_sequence(
+            name, t, g, config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame
+        )
         for name, t, g in sequence_pairs(tracks, gt)
     ]
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"

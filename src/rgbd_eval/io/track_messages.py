@@ -144,10 +144,10 @@ def read_bag_tracks(
             if name in tf_topics:
                 for t in msg.transforms:
                     tr, q = t.transform.translation, t.transform.rotation
-                    pose = Pose((tr.x, tr.y, tr.z), (q.x, q.y, q.z, q.w))
+                    edge = Pose((tr.x, tr.y, tr.z), (q.x, q.y, q.z, q.w))
                     parent, child = t.header.frame_id.lstrip("/"), t.child_frame_id.lstrip("/")
                     try:
-                        tf.add(parent, child, _stamp(t), pose, static=name == "/tf_static")
+                        tf.add(parent, child, _stamp(t), edge, static=name == "/tf_static")
                     except TransformLookupError as err:
                         raise TransformError(path, str(err), name) from err
                 continue
