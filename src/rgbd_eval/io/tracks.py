@@ -12,7 +12,8 @@ Ground truth: MOTChallenge text, with the devkit's rules for MOT16/17/20
 consider flag set are scored; the distractor classes (person on vehicle 2, static
 person 7, distractor 8, reflection 12; MOT20 also non-motorised vehicle 6) are
 ignored and drop the tracks matched to them; everything else is ignored without
-dropping tracks. MOT15 ground truth (no class column) is scored as it is. Other
+dropping tracks. MOT15 ground truth (no class column) is scored except rows whose
+consider flag is 0. Other
 ground truth goes through :func:`rgbd_eval.io.groundtruth.load_ground_truth`
 (our CSV sidecar, KTP).
 """
@@ -183,8 +184,11 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
         frame, oid = int(row[0]), int(row[1])
         ignore, distractor, visibility = False, True, 1.0
         world = None
-        if rules is Benchmark.MOT15 and row.shape[0] >= 10 and not np.all(row[7:10] == -1):
-            world = (float(row[7]), float(row[8]), float(row[9]))
+        if rules is Benchmark.MOT15:
+            if row.shape[0] >= 10 and not np.all(row[7:10] == -1):
+                world = (float(row[7]), float(row[8]), float(row[9]))
+            # TrackEval drops MOT15 rows whose consider flag is 0 (no distractor matching).
+            ignore, distractor = row.shape[0] >= 7 and row[6] == 0, False
         if rules is not Benchmark.MOT15:
             cls = int(row[7])
             scored = cls == _PEDESTRIAN and row[6] != 0
