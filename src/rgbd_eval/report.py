@@ -35,7 +35,6 @@ _LIBRARIES = (
     "open3d",
     "rosbags",
     "mcap",
-    "motmetrics",
     "pydantic",
 )
 
