@@ -402,10 +402,12 @@ def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
         return [(_name(tracks), tracks, gt)]
     if not gt.is_dir():
         raise GroundTruthError(gt, "a folder of tracker output needs a folder of ground truth")
+    # A `run` output folder also holds detections and events CSVs: not tracker output.
     files = sorted(
         p
         for p in tracks.iterdir()
-        if (p.is_file() and p.suffix in (".txt", ".csv")) or is_recording(p)
+        if (p.is_file() and p.suffix in (".txt", ".csv") and not p.name.endswith(_NOT_TRACKS))
+        or is_recording(p)
     )
     if not files:
         raise InputError(tracks, "folder holds no tracker output (.txt, .csv or recordings)")
@@ -425,6 +427,9 @@ def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
             )
         pairs.append((name, f, found))
     return pairs
+
+
+_NOT_TRACKS = (".detections.csv", ".events.csv")
 
 
 def _name(path: Path) -> str:
