@@ -49,8 +49,10 @@ def test_mot17_rules(tmp_path: Path) -> None:
     assert objects[2].ignore and objects[2].distractor
     assert objects[3].ignore and not objects[3].distractor
     assert objects[4].ignore and not objects[4].distractor
-    # MOT15 rules score every row.
-    assert not any(o.ignore for _, _, objs in read_mot_gt(gt, Benchmark.MOT15).frames for o in objs)
+    # MOT15 rules (TrackEval): no classes, only the consider-0 rows (ids 3, 4) are dropped.
+    mot15 = [o for _, _, objs in read_mot_gt(gt, Benchmark.MOT15).frames for o in objs]
+    assert sorted({o.object_id for o in mot15 if o.ignore}) == [3, 4]
+    assert not any(o.distractor for o in mot15 if o.ignore)
 
 
 def test_score_writes_report_and_events(tmp_path: Path) -> None:
