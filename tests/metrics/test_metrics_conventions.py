@@ -18,15 +18,11 @@ FAR = (500.0, 500.0, 10.0, 10.0)
 
 
 def test_previous_match_kept_only_from_the_previous_frame() -> None:
-    # GT 1 at A in 4 frames. Frame 0: track 7 on A. Frame 1: track 7 gone, track 8 on A
-    # (a switch in both conventions). Frame 2: both tracks on A, 8 exact, 7 shifted 1 px
-    # (IoU 90/110 = 0.82). motchallenge keeps 8 (matched in the previous frame): no
-    # switch. motmetrics gives GT 1 back its *last* track... which is 8 as well. Frame 3:
-    # only 7 (shifted): switch in both. Then the difference: frame 4 has 7 shifted and
-    # 8 exact after frame 3 matched 7: motchallenge continues 7, motmetrics too (last = 7).
-    # Differ only when the last match is older than one frame: frame 5 has no match for
-    # GT 1 (tracks far away), frame 6 has 7 shifted and 8 exact: motchallenge takes the
-    # better IoU (8, a switch), motmetrics takes back 7 (no switch).
+    # GT 1 at A in 7 frames; track 8 sits exactly on A, track 7 is 1 px off (IoU 90 / 110
+    # = 0.82). Frames 0-4 give the same matches in both conventions: 7, 8 (switch), 8,
+    # 7 (switch), 7. Frame 5 has both tracks far away: GT 1 is missed. Frame 6 has both
+    # on A: motchallenge has no previous-frame match to keep and takes the better IoU
+    # (8, a switch); motmetrics gives GT 1 back its last track, 7 (no switch).
     shifted = (1.0, 0.0, 10.0, 10.0)
     gts = [[gt(1, A)]] * 7
     tracks = [
