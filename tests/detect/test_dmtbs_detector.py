@@ -15,6 +15,7 @@ from rgbd_eval.detect.dmtbs import (
     DmtbsDetectorConfig,
     FloorSource,
 )
+from rgbd_eval.errors import ConfigError
 from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
 from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
 
@@ -86,13 +87,24 @@ def test_two_cameras_merge_by_maximum() -> None:
 def test_floor_from_the_first_frame_matches_the_world_floor() -> None:
     spec, floor = _overhead("a", 0.5, -0.5)
     results = []
-    for source in (FloorSource.WORLD, FloorSource.FIRST_FRAME):
+    cases = [(FloorSource.WORLD, True), (FloorSource.FIRST_FRAME, True), (FloorSource.AUTO, False)]
+    for source, world_is_floor in cases:
         det = DmtbsDetector(DmtbsDetectorConfig(init_frames=1, floor=source, roi=(-2, -2, 2, 2)))
-        det.detect_views(0, _views([spec], [floor]))
-        results.append(det.detect_views(STEP, _views([spec], [_with_box(floor)])).detections)
-    (world,), (found,) = results
+        det.detect_views(0, _views([spec], [floor]), world_is_floor)
+        results.append(
+            det.detect_views(STEP, _views([spec], [_with_box(floor)]), world_is_floor).detections
+        )
+    (world,), (found,), (auto,) = results
     np.testing.assert_allclose(found.ground_xy, world.ground_xy, atol=1e-6)
     assert found.height == pytest.approx(world.height, abs=1e-6)
+    assert auto.ground_xy == found.ground_xy and auto.height == found.height
+
+
+def test_no_floor_in_the_first_frame_is_a_config_error() -> None:
+    spec, floor = _overhead("a", 0.0, 0.0)
+    det = DmtbsDetector(DmtbsDetectorConfig(floor=FloorSource.FIRST_FRAME))
+    with pytest.raises(ConfigError, match=r"detector\.floor=first_frame: no floor plane"):
+        det.detect_views(0, _views([spec], [np.full_like(floor, np.nan)]))
 
 
 def test_points_below_the_height_cut_are_not_detected() -> None:

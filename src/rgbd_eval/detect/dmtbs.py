@@ -40,6 +40,7 @@ from rgbd_eval.detect.calibration import (
     world_floor_frame,
 )
 from rgbd_eval.detect.density import CameraMap, FloorGrid, camera_density, merge_maps
+from rgbd_eval.errors import ConfigError
 from rgbd_eval.plugins import (
     DetectionContract,
     DetectorSpec,
@@ -63,6 +64,9 @@ class BackgroundMethod(enum.Enum):
 class FloorSource(enum.Enum):
     """Where the floor plane comes from (seed 003, section 3)."""
 
+    #: ``world`` when the recording places its cameras in a world frame (tf, odometry) or a
+    #: calibration file is given, else ``first_frame`` (a lone camera in its own frame)
+    AUTO = "auto"
     #: the world frame's z = 0 plane (tf from the recording), or the calibration file's floor
     WORLD = "world"
     #: found in the first depth image of the first camera (RANSAC)
@@ -103,7 +107,7 @@ class DmtbsDetectorConfig(ComponentConfig):
     closing_radius_m: float = Field(
         0.1, ge=0.0, description="disk radius of the closing (seed 003, 3.3: 10 cm)"
     )
-    floor: FloorSource = Field(FloorSource.WORLD, description="where the floor plane comes from")
+    floor: FloorSource = Field(FloorSource.AUTO, description="where the floor plane comes from")
     floor_band_m: float = Field(0.03, gt=0.0, description="RANSAC inlier band of the floor (m)")
     floor_max_tilt_deg: float = Field(
         30.0, gt=0.0, lt=90.0, description="largest floor tilt from the world's up (deg)"
@@ -195,10 +199,16 @@ class DmtbsDetector:
             stream = frame.streams[role]
             image = np.asarray(stream.image, dtype=np.float32)
             views.append(DepthView(role, image, stream.camera, stream.pose))
-        return self.detect_views(frame.stamp_ns, views).detections
+        return self.detect_views(frame.stamp_ns, views, frame.has_odometry).detections
 
-    def detect_views(self, stamp_ns: int, views: list[DepthView]) -> DensityResult:
-        """Detections in the world frame from the synchronised depth images of all cameras."""
+    def detect_views(
+        self, stamp_ns: int, views: list[DepthView], world_is_floor: bool = True
+    ) -> DensityResult:
+        """Detections in the world frame from the synchronised depth images of all cameras.
+
+        ``world_is_floor``: the views' poses place them in a z-up world whose z = 0 is the
+        floor (what ``floor: auto`` then uses); False for a camera in its own frame.
+        """
         if not views:
             raise ValueError("DMT-BS needs at least one depth camera")
         dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
@@ -207,7 +217,7 @@ class DmtbsDetector:
         timings = dict.fromkeys(STAGES, 0.0)
         maps: list[CameraMap] = []
         for view in views:
-            cam = self._camera(view)
+            cam = self._camera(view, world_is_floor)
             t0 = time.perf_counter()
             foreground = cam.background.apply(view.depth, dt)
             t1 = time.perf_counter()
@@ -234,7 +244,7 @@ class DmtbsDetector:
 
     # ------------------------------------------------------------------ helpers
 
-    def _camera(self, view: DepthView) -> _Camera:
+    def _camera(self, view: DepthView, world_is_floor: bool) -> _Camera:
         cam = self._cameras.get(view.name)
         if cam is not None:
             return cam
@@ -244,7 +254,7 @@ class DmtbsDetector:
             else view.world_from_optical
         )
         if self._floor_T_world is None:
-            self._floor_T_world = self._floor(view, world_T_optical)
+            self._floor_T_world = self._floor(view, world_T_optical, world_is_floor)
         calibration = CameraCalibration(
             view.name, view.camera, self._floor_T_world.compose(world_T_optical)
         )
@@ -252,15 +262,22 @@ class DmtbsDetector:
         self._cameras[view.name] = cam
         return cam
 
-    def _floor(self, view: DepthView, world_T_optical: Pose) -> Pose:
+    def _floor(self, view: DepthView, world_T_optical: Pose, world_is_floor: bool) -> Pose:
         cfg = self._cfg
-        if cfg.floor is FloorSource.WORLD:
+        source = cfg.floor
+        if source is FloorSource.AUTO:
+            world = world_is_floor or self._file is not None
+            source = FloorSource.WORLD if world else FloorSource.FIRST_FRAME
+        if source is FloorSource.WORLD:
             plane = self._file.floor_plane() if self._file is not None else np.array([0, 0, 1.0, 0])
             return world_floor_frame(plane)
         up = world_T_optical.rotation_matrix().T @ np.array([0.0, 0.0, 1.0])
-        plane_optical = floor_from_depth(
-            view.depth, view.camera, up, cfg.floor_band_m, cfg.floor_max_tilt_deg
-        )
+        try:
+            plane_optical = floor_from_depth(
+                view.depth, view.camera, up, cfg.floor_band_m, cfg.floor_max_tilt_deg
+            )
+        except ValueError as err:
+            raise ConfigError(f"detector.floor={source.value}: {err}") from err
         return world_floor_frame(plane_in_world(plane_optical, world_T_optical))
 
     def _background(self) -> BackgroundSubtractor:
