@@ -99,3 +99,19 @@ def test_mog2_reports_nothing_while_initialising_and_checks_variances() -> None:
     assert not any(bg.apply(z, 0.1).any() for _ in range(3))
     with pytest.raises(ValueError, match="variances"):
         Mog2Background(3, 1.0, 16.0, 0.001, 0.01, 0.2)
+
+
+def test_mog2_does_not_flag_a_revealed_farther_surface() -> None:
+    # An object at 2 m stands in front of a 3 m wall while MOG2 learns; when it leaves,
+    # the wall (farther than the learnt background) is no foreground; a new object is.
+    rng = np.random.default_rng(5)
+    bg = Mog2Background(10, 3.0, 16.0, 0.05**2, 0.01**2, 0.2**2)
+    for _ in range(20):
+        z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+        z[10:20, 10:20] = 2.0
+        bg.apply(z, 1 / 30)
+    z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+    z[25:35, 25:35] = 1.5
+    fg = bg.apply(z, 1 / 30)
+    assert not fg[10:20, 10:20].any()
+    assert fg[25:35, 25:35].all()

@@ -157,7 +157,8 @@ _running_average_kernel: Callable[
 class Mog2Background:
     """OpenCV's MOG2 with two mixtures on the depth image in metres (seed 003, Fig. 10).
 
-    Invalid pixels enter as 0 m (a value of their own) and are never foreground; MOG2's
+    Invalid pixels enter as 0 m (a value of their own) and are never foreground; nor is what
+    lies farther than MOG2's background image (a revealed surface, not an object); MOG2's
     variances are set in metres squared (its defaults are for 8-bit intensities). The
     learning rate follows the same time constant as the running average; the first
     ``init_frames`` frames learn with rate ``1/n`` (a plain mean) and report no foreground.
@@ -202,5 +203,8 @@ class Mog2Background:
             return np.zeros(z.shape, dtype=bool)
         rate = 1.0 - math.exp(-max(dt_s, 0.0) / self.time_constant_s)
         mask = self._mog.apply(image, learningRate=rate)
-        foreground: BoolImage = (mask > 0) & valid
+        # Foreground is what lies nearer than the background (seed 003, 3.1): MOG2 flags any
+        # change, also a surface revealed behind someone who left (a "ghost" farther away).
+        background = self._mog.getBackgroundImage()
+        foreground: BoolImage = (mask > 0) & valid & (z < background)
         return foreground
