@@ -1,0 +1,421 @@
+"""The HTML pages: a run's ``report.html`` and the pages of sweep, compare, reproduce and bench.
+
+Each ``*_page`` function returns the HTML text of one self-contained page (no
+file access); :func:`write_run_html` also reads the frames it draws and writes
+the files of a run.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rgbd_eval.atomic import write_text
+from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
+from rgbd_eval.metrics import summarize
+from rgbd_eval.pipeline import SequenceResult
+from rgbd_eval.report import format_value, run_notes, table_header, table_rows
+from rgbd_eval.report_html import plots
+from rgbd_eval.report_html.events import frame_errors, markers, worst_frames
+from rgbd_eval.report_html.overlay import rgb_frames
+from rgbd_eval.report_html.render import data_uri, jpeg_uri, render
+from rgbd_eval.report_html.video import Progress, overlay, write_overlay_video
+
+if TYPE_CHECKING:
+    from rgbd_eval.bench import BenchResult
+    from rgbd_eval.compare import Comparison
+    from rgbd_eval.reproduce import Reproduction
+    from rgbd_eval.sweep import SweepResult
+
+#: Frames in the worst-frame strip of each sequence.
+WORST_FRAMES = 6
+#: Columns of the short metric tables (sweep, reproduce): (key, header, kind as in report.COLUMNS).
+SHORT_COLUMNS = (
+    ("motp", "MOTP", "motp"),
+    ("mota", "MOTA", "pct"),
+    ("fp_rate", "FP", "pct"),
+    ("fn_rate", "FN", "pct"),
+    ("id_switches", "ID Sw.", "int"),
+    ("main_tr", "Main Tr.", "pct"),
+    ("all_tr", "All Tr.", "pct"),
+)
+#: Shares among the compared metrics (shown in percentage points); MOTP is one only under IoU gating.
+PERCENT_METRICS = ("mota", "idf1", "main_tr", "all_tr")
+
+
+# ----------------------------------------------------------------------------- run
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One frame of the worst-frame strip."""
+
+    frame: int
+    uri: str
+    caption: str
+
+
+@dataclass(frozen=True)
+class SequenceSection:
+    """Everything the page shows of one sequence."""
+
+    name: str
+    birds_eye: str
+    timeline: str | None
+    shots: tuple[Shot, ...]
+    error_frames: int
+    video: str | None
+
+
+def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
+    if isinstance(value, Mapping):
+        for k, v in value.items():
+            _flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
+    else:
+        out[prefix] = value
+
+
+def config_diff(config: RunConfig) -> list[tuple[str, Any, Any]]:
+    """``(key, method default, used)`` for every config value that differs from the method's file."""
+    defaults: dict[str, Any] = {}
+    used: dict[str, Any] = {}
+    _flatten("", config_to_dict(load_config(method=config.method)), defaults)
+    _flatten("", config_to_dict(config), used)
+    return [
+        (k, defaults.get(k), used.get(k))
+        for k in sorted(set(defaults) | set(used))
+        if defaults.get(k) != used.get(k)
+    ]
+
+
+def _section(
+    folder: Path,
+    r: SequenceResult,
+    images: Mapping[int, NDArray[np.uint8]],
+    worst: Sequence[int],
+    video: str | None,
+) -> SequenceSection:
+    """The section of one sequence; also writes its ``<name>.birdseye.png`` into ``folder``."""
+    marks = markers(r.scores.frames) if r.scores is not None else []
+    png = plots.birds_eye(
+        r.name,
+        r.info.world_frame,
+        r.ground_truth.frames if r.ground_truth is not None else None,
+        r.tracks,
+        marks,
+    )
+    (folder / f"{r.name}.birdseye.png").write_bytes(png)
+    birds_eye = data_uri(png)
+    if r.scores is None:
+        return SequenceSection(r.name, birds_eye, None, (), 0, video)
+    errors = frame_errors(r.scores.frames)
+    shots = []
+    for i in worst:
+        e = errors[i]
+        caption = f"frame {i}: {e.fp} FP, {e.fn} FN, {e.id_switches} ID switch(es)"
+        shots.append(Shot(i, jpeg_uri(images[i]), caption))
+    return SequenceSection(
+        r.name,
+        birds_eye,
+        plots.timeline(errors, worst),
+        tuple(shots),
+        sum(e.total > 0 for e in errors),
+        video,
+    )
+
+
+def run_page(
+    results: Sequence[SequenceResult],
+    config: RunConfig,
+    report: Mapping[str, Any],
+    sections: Sequence[SequenceSection],
+) -> str:
+    """``report.html`` of a run: header, metrics table, then one section per sequence."""
+    scored = any(r.scores is not None for r in results)
+    return render(
+        "run.html.j2",
+        title=f"rgbd-eval run: {config.method}",
+        method=config.method,
+        evaluation=report["evaluation"],
+        diff=config_diff(config),
+        sequences=report["sequences"],
+        tool=report["tool"],
+        libraries=report["libraries"],
+        header=table_header() if scored else [],
+        rows=table_rows(results, config.evaluation.gating) if scored else [],
+        notes=run_notes(results),
+        sections=sections,
+    )
+
+
+def write_run_html(
+    folder: Path,
+    results: Sequence[SequenceResult],
+    config: RunConfig,
+    report: Mapping[str, Any],
+    video: bool = False,
+    progress: Progress | None = None,
+) -> None:
+    """Write ``report.html``, a ``<name>.birdseye.png`` per sequence and, with ``video``, a
+    ``<name>.overlay.mp4`` per sequence into ``folder`` (a run's staged output folder).
+
+    The recordings are read again for the RGB images: with ``video`` every frame,
+    else only up to the last of the worst frames.
+    """
+    sections = []
+    for r in results:
+        worst = worst_frames(frame_errors(r.scores.frames), WORST_FRAMES) if r.scores else []
+        video_name = None
+        if video:
+            video_name = f"{r.name}.overlay.mp4"
+            made = write_overlay_video(folder / video_name, r, config.io, worst, progress)
+            images = made.kept
+        else:
+            images = {
+                i: overlay(r, i, rgb) for i, rgb in rgb_frames(Path(r.path), config.io, worst)
+            }
+        sections.append(_section(folder, r, images, worst, video_name))
+    write_text(folder / "report.html", run_page(results, config, report, sections))
+
+
+# ----------------------------------------------------------------------------- sweep
+
+
+def _short_cells(summary: Mapping[str, Any], gating: Gating) -> list[str]:
+    return [format_value(dict(summary), k, kind, gating) for k, _, kind in SHORT_COLUMNS]
+
+
+def sweep_page(
+    result: SweepResult, method: str, datasets: Sequence[str], fixed: Sequence[str], gating: Gating
+) -> str:
+    """``sweep.html``: indicator curves per parameter, a heat map for two, the records."""
+    overall = [(point, summarize(counts)) for point, counts in result.overall()]
+    best_point, _ = max(
+        overall, key=lambda ps: float(ps[1]["mota"] if ps[1]["mota"] is not None else -1e9)
+    )
+    curves = []
+    for param in result.params:
+        others = {k: v for k, v in best_point.items() if k != param}
+        line = [(p, s) for p, s in overall if all(p[k] == v for k, v in others.items())]
+        held = ", ".join(f"{k}={v}" for k, v in others.items())
+        title = "all sequences summed" + (f"; {held} (the best point)" if held else "")
+        curves.append(
+            plots.indicator_curves(param, [p[param] for p, _ in line], [s for _, s in line], title)
+        )
+    heat = None
+    if len(result.params) == 2:
+        a, b = result.params
+        rows = list(dict.fromkeys(p[a] for p, _ in overall))
+        cols = list(dict.fromkeys(p[b] for p, _ in overall))
+        mota = {(p[a], p[b]): s["mota"] for p, s in overall}
+        grid = [[_float_or_none(mota.get((r, c))) for c in cols] for r in rows]
+        heat = plots.heat_map(a, rows, b, cols, grid, "MOTA (%), all sequences summed")
+    records = [
+        (
+            [str(r.point[p]) for p in result.params],
+            r.sequence,
+            _short_cells(summarize(r.counts), gating),
+        )
+        for r in result.records
+    ]
+    return render(
+        "sweep.html.j2",
+        title=f"rgbd-eval sweep: {', '.join(result.params)}",
+        method=method,
+        params=result.params,
+        datasets=datasets,
+        fixed=fixed,
+        best=best_point,
+        curves=curves,
+        heat=heat,
+        columns=[h for _, h, _ in SHORT_COLUMNS],
+        overall=[
+            ([str(p[k]) for k in result.params], _short_cells(s, gating), p == best_point)
+            for p, s in overall
+        ],
+        records=records,
+        cache=(result.cache_hits, result.cache_misses),
+    )
+
+
+def _float_or_none(value: Any) -> float | None:
+    return None if value is None else float(value)
+
+
+# ----------------------------------------------------------------------------- compare
+
+
+def compare_page(comparison: Comparison, baseline: str, current: str) -> str:
+    """``compare.html``: the per-sequence deltas, coloured by improvement or regression."""
+    from rgbd_eval.compare import HEADER, Status
+    from rgbd_eval.compare import table_rows as delta_rows
+
+    sequences = list(dict.fromkeys(d.sequence for d in comparison.deltas))
+    metrics = list(dict.fromkeys(d.metric for d in comparison.deltas))
+    direction = {Status.BETTER: 1.0, Status.WORSE: -1.0, Status.REGRESSED: -1.0}
+    gains: dict[tuple[str, str], tuple[float, str]] = {}
+    for d in comparison.deltas:
+        change = d.change
+        if change is None:
+            continue
+        # The status knows each metric's direction (MOTP's flips with the gating): gain > 0 is better.
+        scale = 100.0 if d.metric.endswith("_rate") or d.metric in PERCENT_METRICS else 1.0
+        gains[d.sequence, d.metric] = (
+            direction.get(d.status, 0.0) * abs(change) * scale,
+            d.status.value,
+        )
+    return render(
+        "compare.html.j2",
+        title="rgbd-eval compare",
+        baseline=baseline,
+        current=current,
+        header=HEADER,
+        rows=delta_rows(comparison),
+        regressions=len(comparison.regressions),
+        config_changes=comparison.config_changes,
+        chart=plots.delta_bars(sequences, metrics, gains),
+    )
+
+
+# ----------------------------------------------------------------------------- reproduce
+
+
+def _paper_row(rows: Mapping[Any, Any], key: str) -> Mapping[str, Any] | None:
+    """The row of ``rows`` named ``key``: by name, ignoring case, or by numeric value.
+
+    The paper's YAML keys may be numbers or booleans (``-1.0``, ``true``), ours are strings.
+    """
+    for k, v in rows.items():
+        if str(k).lower() == key.lower():
+            return dict(v)
+        try:
+            if float(k) == float(key):
+                return dict(v)
+        except (TypeError, ValueError):
+            continue
+    return None
+
+
+def _cell(value: Any, key: str) -> str:
+    if value is None:
+        return "-"
+    return str(int(value)) if key == "id_switches" else f"{100 * float(value):.1f}%"
+
+
+def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> str:
+    """``reproduce.html``: per table the paper's value beside ours, the claims, the figures redrawn."""
+    tables = []
+    for tab, measured in res.tables.items():
+        spec = paper.get("tables", {}).get(tab)
+        if spec is None:
+            continue
+        names = [str(k).lower() for k in spec["rows"]]
+        names += [n for n in measured if _paper_row(spec["rows"], n) is None]
+        cols = [
+            (k, h) for k, h, _ in SHORT_COLUMNS if any(k in dict(v) for v in spec["rows"].values())
+        ]
+        rows = []
+        for name in names:
+            p, o = _paper_row(spec["rows"], name), _paper_row(measured, name)
+            rows.append(
+                (name, [(_cell((p or {}).get(k), k), _cell((o or {}).get(k), k)) for k, _ in cols])
+            )
+        numeric = _all_numeric(names)
+        if numeric and len(names) >= 3:
+            figure = plots.indicator_curves(
+                str(spec.get("param", "value")),
+                [float(n) for n in names],
+                [dict(_paper_row(measured, n) or {}) for n in names],
+                f"{spec['title']}: paper (dashed) and measured (solid)",
+                paper=[_paper_row(spec["rows"], n) for n in names],
+            )
+        else:
+            figure = plots.paper_vs_measured(
+                names,
+                [_float_or_none((_paper_row(spec["rows"], n) or {}).get("mota")) for n in names],
+                [_float_or_none((_paper_row(measured, n) or {}).get("mota")) for n in names],
+                "MOTA",
+                spec["title"],
+            )
+        tables.append((spec["title"], [h for _, h in cols], rows, figure))
+    figures = []
+    if res.track_lengths:
+        text = paper.get("figures", {}).get("7.7", "")
+        figures.append(
+            (
+                "Figure 7.7: frames each distinct track remains",
+                plots.track_lengths(res.track_lengths),
+                text,
+            )
+        )
+    if res.voxel_timing:
+        stages = [s for s in next(iter(res.voxel_timing.values())) if s != "total_detect"]
+        groups = [f"{v:.2f}" for v in res.voxel_timing]
+        ms = [[t[s] for s in stages] for t in res.voxel_timing.values()]
+        figure = plots.stacked_stages(
+            groups,
+            stages,
+            ms,
+            "voxel size (m)",
+            "detection time per stage (one core)",
+            limit_ms=1000.0 / 30.0,
+        )
+        figures.append(
+            (
+                "Figure 7.9: detection time against voxel size",
+                figure,
+                paper.get("figures", {}).get("7.9", ""),
+            )
+        )
+    return render(
+        "reproduce.html.j2",
+        title=f"rgbd-eval reproduce {method}",
+        method=method,
+        source=paper.get("source", ""),
+        seconds=res.seconds,
+        tables=tables,
+        figures=figures,
+        claims=res.claims,
+    )
+
+
+def _all_numeric(names: Sequence[str]) -> bool:
+    try:
+        [float(n) for n in names]
+    except ValueError:
+        return False
+    return True
+
+
+# ----------------------------------------------------------------------------- bench
+
+
+def bench_page(result: BenchResult, labels: Mapping[str, str]) -> str:
+    """``bench.html``: per-stage bars against the decode floor, and the figures as a table."""
+    stage_ms = {labels.get(s, s): ms for s, ms in result.stage_ms.items()}
+    (rw, rh), (dw, dh) = result.rgb_size, result.depth_size
+    title = (
+        f"{result.method} on {Path(result.path).name}: {result.frames} frames, RGB {rw}x{rh}, depth {dw}x{dh}; "
+        f"pipeline {result.fps:.1f} fps, floor {result.floor_fps:.1f} fps"
+    )
+    rows = [
+        (
+            name,
+            f"{ms:.3f}",
+            f"{100.0 * ms / result.total_ms:.1f}%",
+            "-" if ms <= 0 else f"{1e3 / ms:.0f}",
+        )
+        for name, ms in stage_ms.items()
+    ]
+    return render(
+        "bench.html.j2",
+        title=f"rgbd-eval bench: {Path(result.path).name}",
+        result=result,
+        chart=plots.stage_bars(stage_ms, result.total_ms, result.floor_ms, title),
+        rows=rows,
+    )
