@@ -28,6 +28,7 @@ def reproduce(
         raise ConfigError(f"reproduce {system!r}: only basso2012 is available")
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.datasets import scenarios_dir
+    from rgbd_eval.report_html import reproduce_page
     from rgbd_eval.reproduce import (
         SCENARIOS,
         paper_values,
@@ -55,5 +56,9 @@ def reproduce(
     text = render_markdown(res, paper_values())
     write_text(out_dir / "reproduce.md", text)
     write_json(out_dir / "reproduce.json", to_json(res))
+    write_text(out_dir / "reproduce.html", reproduce_page(res, paper_values(), system))
     console.print(text, markup=False)
-    console.print(f"written: {out_dir / 'reproduce.md'}, {out_dir / 'reproduce.json'}")
+    console.print(
+        f"written: {out_dir / 'reproduce.md'}, {out_dir / 'reproduce.json'}, "
+        f"{out_dir / 'reproduce.html'}"
+    )

@@ -7,6 +7,7 @@ from rgbd_eval.report_html.pages import (
     run_page,
     sweep_page,
     write_run_html,
+    write_sweep_html,
 )
 
 __all__ = [
@@ -16,4 +17,5 @@ __all__ = [
     "run_page",
     "sweep_page",
     "write_run_html",
+    "write_sweep_html",
 ]

@@ -7,6 +7,7 @@ the files of a run.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,9 +16,9 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.atomic import write_text
+from rgbd_eval.atomic import write_bytes, write_text
 from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
-from rgbd_eval.metrics import summarize
+from rgbd_eval.metrics import Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
 from rgbd_eval.report import format_value, run_notes, table_header, table_rows
 from rgbd_eval.report_html import plots
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
     from rgbd_eval.compare import Comparison
     from rgbd_eval.reproduce import Reproduction
-    from rgbd_eval.sweep import SweepResult
+    from rgbd_eval.sweep import Point, SweepResult
 
 #: Frames in the worst-frame strip of each sequence.
 WORST_FRAMES = 6
@@ -44,8 +45,6 @@ SHORT_COLUMNS = (
     ("main_tr", "Main Tr.", "pct"),
     ("all_tr", "All Tr.", "pct"),
 )
-#: Shares among the compared metrics (shown in percentage points); MOTP is one only under IoU gating.
-PERCENT_METRICS = ("mota", "idf1", "main_tr", "all_tr")
 
 
 # ----------------------------------------------------------------------------- run
@@ -122,7 +121,7 @@ def _section(
     return SequenceSection(
         r.name,
         birds_eye,
-        plots.timeline(errors, worst),
+        data_uri(plots.timeline(errors, worst)),
         tuple(shots),
         sum(e.total > 0 for e in errors),
         video,
@@ -190,17 +189,21 @@ def _short_cells(summary: Mapping[str, Any], gating: Gating) -> list[str]:
     return [format_value(dict(summary), k, kind, gating) for k, _, kind in SHORT_COLUMNS]
 
 
-def sweep_page(
-    result: SweepResult, method: str, datasets: Sequence[str], fixed: Sequence[str], gating: Gating
-) -> str:
-    """``sweep.html``: indicator curves per parameter, a heat map for two, the records."""
+def best_point(overall: Sequence[tuple[Point, Summary]]) -> Point:
+    """The grid point of highest MOTA (the first of equals); points without MOTA rank last."""
+    return max(
+        overall, key=lambda ps: -math.inf if ps[1]["mota"] is None else float(ps[1]["mota"])
+    )[0]
+
+
+def sweep_figures(result: SweepResult) -> tuple[list[bytes], bytes | None]:
+    """PNGs: per parameter its indicator curves (the other parameters held at the best
+    point), and for a two-parameter grid the MOTA heat map."""
     overall = [(point, summarize(counts)) for point, counts in result.overall()]
-    best_point, _ = max(
-        overall, key=lambda ps: float(ps[1]["mota"] if ps[1]["mota"] is not None else -1e9)
-    )
+    best = best_point(overall)
     curves = []
     for param in result.params:
-        others = {k: v for k, v in best_point.items() if k != param}
+        others = {k: v for k, v in best.items() if k != param}
         line = [(p, s) for p, s in overall if all(p[k] == v for k, v in others.items())]
         held = ", ".join(f"{k}={v}" for k, v in others.items())
         title = "all sequences summed" + (f"; {held} (the best point)" if held else "")
@@ -215,6 +218,21 @@ def sweep_page(
         mota = {(p[a], p[b]): s["mota"] for p, s in overall}
         grid = [[_float_or_none(mota.get((r, c))) for c in cols] for r in rows]
         heat = plots.heat_map(a, rows, b, cols, grid, "MOTA (%), all sequences summed")
+    return curves, heat
+
+
+def sweep_page(
+    result: SweepResult,
+    method: str,
+    datasets: Sequence[str],
+    fixed: Sequence[str],
+    gating: Gating,
+    figures: tuple[list[bytes], bytes | None],
+) -> str:
+    """``sweep.html``: the :func:`sweep_figures`, the best point, the records."""
+    overall = [(point, summarize(counts)) for point, counts in result.overall()]
+    best = best_point(overall)
+    curves, heat = figures
     records = [
         (
             [str(r.point[p]) for p in result.params],
@@ -230,17 +248,32 @@ def sweep_page(
         params=result.params,
         datasets=datasets,
         fixed=fixed,
-        best=best_point,
-        curves=curves,
-        heat=heat,
+        best=best,
+        curves=[data_uri(c) for c in curves],
+        heat=None if heat is None else data_uri(heat),
         columns=[h for _, h, _ in SHORT_COLUMNS],
         overall=[
-            ([str(p[k]) for k in result.params], _short_cells(s, gating), p == best_point)
+            ([str(p[k]) for k in result.params], _short_cells(s, gating), p == best)
             for p, s in overall
         ],
         records=records,
         cache=(result.cache_hits, result.cache_misses),
     )
+
+
+def write_sweep_html(
+    out_dir: Path,
+    result: SweepResult,
+    method: str,
+    datasets: Sequence[str],
+    fixed: Sequence[str],
+    gating: Gating,
+) -> None:
+    """Write ``sweep.html`` and, for a one-parameter sweep, its curves as ``sweep.png``."""
+    figures = sweep_figures(result)
+    if len(result.params) == 1:
+        write_bytes(out_dir / "sweep.png", figures[0][0])
+    write_text(out_dir / "sweep.html", sweep_page(result, method, datasets, fixed, gating, figures))
 
 
 def _float_or_none(value: Any) -> float | None:
@@ -252,33 +285,24 @@ def _float_or_none(value: Any) -> float | None:
 
 def compare_page(comparison: Comparison, baseline: str, current: str) -> str:
     """``compare.html``: the per-sequence deltas, coloured by improvement or regression."""
-    from rgbd_eval.compare import HEADER, Status
+    from rgbd_eval.compare import HEADER
     from rgbd_eval.compare import table_rows as delta_rows
 
-    sequences = list(dict.fromkeys(d.sequence for d in comparison.deltas))
-    metrics = list(dict.fromkeys(d.metric for d in comparison.deltas))
-    direction = {Status.BETTER: 1.0, Status.WORSE: -1.0, Status.REGRESSED: -1.0}
-    gains: dict[tuple[str, str], tuple[float, str]] = {}
-    for d in comparison.deltas:
-        change = d.change
-        if change is None:
-            continue
-        # The status knows each metric's direction (MOTP's flips with the gating): gain > 0 is better.
-        scale = 100.0 if d.metric.endswith("_rate") or d.metric in PERCENT_METRICS else 1.0
-        gains[d.sequence, d.metric] = (
-            direction.get(d.status, 0.0) * abs(change) * scale,
-            d.status.value,
-        )
+    rows = delta_rows(comparison)
+    sequences = list(dict.fromkeys(r[0] for r in rows))
+    metrics = list(dict.fromkeys(r[1] for r in rows))
+    # (sequence, metric, baseline, current, change, status) -> the change, coloured by status
+    cells = {(r[0], r[1]): (r[4], r[5]) for r in rows}
     return render(
         "compare.html.j2",
         title="rgbd-eval compare",
         baseline=baseline,
         current=current,
         header=HEADER,
-        rows=delta_rows(comparison),
+        rows=rows,
         regressions=len(comparison.regressions),
         config_changes=comparison.config_changes,
-        chart=plots.delta_bars(sequences, metrics, gains),
+        chart=data_uri(plots.delta_grid(sequences, metrics, cells)),
     )
 
 
@@ -342,14 +366,14 @@ def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> 
                 "MOTA",
                 spec["title"],
             )
-        tables.append((spec["title"], [h for _, h in cols], rows, figure))
+        tables.append((spec["title"], [h for _, h in cols], rows, data_uri(figure)))
     figures = []
     if res.track_lengths:
         text = paper.get("figures", {}).get("7.7", "")
         figures.append(
             (
                 "Figure 7.7: frames each distinct track remains",
-                plots.track_lengths(res.track_lengths),
+                data_uri(plots.track_lengths(res.track_lengths)),
                 text,
             )
         )
@@ -368,7 +392,7 @@ def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> 
         figures.append(
             (
                 "Figure 7.9: detection time against voxel size",
-                figure,
+                data_uri(figure),
                 paper.get("figures", {}).get("7.9", ""),
             )
         )
@@ -416,6 +440,6 @@ def bench_page(result: BenchResult, labels: Mapping[str, str]) -> str:
         "bench.html.j2",
         title=f"rgbd-eval bench: {Path(result.path).name}",
         result=result,
-        chart=plots.stage_bars(stage_ms, result.total_ms, result.floor_ms, title),
+        chart=data_uri(plots.stage_bars(stage_ms, result.total_ms, result.floor_ms, title)),
         rows=rows,
     )

@@ -1,4 +1,4 @@
-"""The plots of the HTML pages, each returned as a PNG ``data:`` URI (matplotlib, Agg)."""
+"""The plots of the HTML pages, each returned as PNG bytes (matplotlib, Agg)."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ import numpy as np
 
 from rgbd_eval.report_html.events import FrameErrors, Marker, MarkerKind
 from rgbd_eval.report_html.overlay import track_colour
-from rgbd_eval.report_html.render import figure_png, figure_uri, pyplot
+from rgbd_eval.report_html.render import figure_png, pyplot
 from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 DPI = 100
@@ -91,7 +91,7 @@ def birds_eye(
     return figure_png(fig)
 
 
-def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> str:
+def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> bytes:
     """FP and FN per frame (steps), id switches (red ticks), the worst frames marked on top."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 2.8), dpi=DPI)
@@ -120,7 +120,7 @@ def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> str:
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
 def _positions(values: Sequence[Any]) -> tuple[list[float], list[str] | None]:
@@ -136,7 +136,7 @@ def indicator_curves(
     summaries: Sequence[Mapping[str, Any]],
     title: str,
     paper: Sequence[Mapping[str, Any] | None] | None = None,
-) -> str:
+) -> bytes:
     """MOTA, FP, FN (%) and ID switches against a parameter, as the thesis' Figure 7.10.
 
     With ``paper`` (one row of published values per x, or None), the paper's
@@ -169,7 +169,7 @@ def indicator_curves(
     ax.grid(True, alpha=0.3)
     ax.set_title(title)
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
 def heat_map(
@@ -179,13 +179,15 @@ def heat_map(
     cols: Sequence[Any],
     values: Sequence[Sequence[float | None]],
     title: str,
-) -> str:
+) -> bytes:
     """A two-parameter grid of one share (in %), each cell annotated."""
     plt = pyplot()
     grid = np.array(
         [[np.nan if v is None else 100.0 * v for v in row] for row in values], dtype=float
     )
-    fig, ax = plt.subplots(figsize=(1.2 + 0.9 * len(cols), 1.4 + 0.55 * len(rows)), dpi=DPI)
+    fig, ax = plt.subplots(
+        figsize=(max(4.5, 1.6 + 0.9 * len(cols)), max(3.0, 1.4 + 0.55 * len(rows))), dpi=DPI
+    )
     image = ax.imshow(grid, cmap="viridis", aspect="auto")
     for i in range(len(rows)):
         for j in range(len(cols)):
@@ -207,53 +209,57 @@ def heat_map(
     ax.set_title(title)
     fig.colorbar(image, ax=ax, label="%")
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
-def delta_bars(
+#: Cell colours of the compare grid, by the comparison's status.
+STATUS_COLOURS = {
+    "better": "#9fd89f",
+    "worse": "#f3e38a",
+    "regressed": "#ef8a8a",
+    "same": "#ffffff",
+    "missing": "#dddddd",
+}
+
+
+def delta_grid(
     sequences: Sequence[str],
     metrics: Sequence[str],
-    gains: Mapping[tuple[str, str], tuple[float, str]],
-) -> str:
-    """Per metric, one bar per sequence: signed gain (positive = better) coloured by status.
+    cells: Mapping[tuple[str, str], tuple[str, str]],
+) -> bytes:
+    """A sequences x metrics grid: each cell the change as text, coloured by its status.
 
-    ``gains[(sequence, metric)]`` is ``(gain, status)``; shares are in percentage
-    points, counts as they are.
+    ``cells[(sequence, metric)]`` is ``(text, status)``; absent cells are ``missing``.
     """
+    from matplotlib.colors import to_rgb
+
     plt = pyplot()
-    colours = {
-        "better": "tab:green",
-        "worse": "gold",
-        "regressed": "tab:red",
-        "same": "0.7",
-        "missing": "0.9",
-    }
-    fig, axes = plt.subplots(
-        1,
-        len(metrics),
-        figsize=(max(6.0, 2.1 * len(metrics)), 0.6 + 0.45 * len(sequences) + 1.0),
-        dpi=DPI,
-        squeeze=False,
+    fig, ax = plt.subplots(
+        figsize=(1.6 + 1.05 * len(metrics), 0.9 + 0.42 * len(sequences)), dpi=DPI
     )
-    for ax, metric in zip(axes[0], metrics, strict=True):
-        ys = np.arange(len(sequences))
-        vals = [gains.get((s, metric), (0.0, "missing")) for s in sequences]
-        ax.barh(
-            ys,
-            [v for v, _ in vals],
-            color=[colours[st] for _, st in vals],
-            edgecolor="black",
-            linewidth=0.4,
-        )
-        ax.axvline(0, color="black", lw=0.8)
-        ax.set_yticks(ys, list(sequences) if ax is axes[0][0] else [""] * len(sequences))
-        ax.invert_yaxis()
-        ax.set_title(metric, fontsize=9)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, axis="x", alpha=0.3)
-    fig.suptitle("gain over the baseline (right = better; shares in points)", fontsize=9)
+    grid = np.array(
+        [
+            [to_rgb(STATUS_COLOURS[cells.get((s, m), ("", "missing"))[1]]) for m in metrics]
+            for s in sequences
+        ]
+    )
+    ax.imshow(grid, aspect="auto")
+    for i, s in enumerate(sequences):
+        for j, m in enumerate(metrics):
+            text = cells.get((s, m), ("-", "missing"))[0]
+            ax.text(j, i, text, ha="center", va="center", fontsize=7)
+    ax.set_xticks(range(len(metrics)), list(metrics), rotation=30, ha="right", fontsize=8)
+    ax.set_yticks(range(len(sequences)), list(sequences), fontsize=8)
+    ax.set_xticks(np.arange(-0.5, len(metrics)), minor=True)
+    ax.set_yticks(np.arange(-0.5, len(sequences)), minor=True)
+    ax.grid(which="minor", color="0.6", lw=0.5)
+    ax.tick_params(which="minor", length=0)
+    ax.set_title(
+        "change from baseline: green better, yellow worse within tolerance, red regressed",
+        fontsize=8,
+    )
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
 def paper_vs_measured(
@@ -262,7 +268,7 @@ def paper_vs_measured(
     measured: Sequence[float | None],
     label: str,
     title: str,
-) -> str:
+) -> bytes:
     """Grouped bars of one share (in %), the paper's beside ours."""
     plt = pyplot()
     xs = np.arange(len(names))
@@ -284,10 +290,10 @@ def paper_vs_measured(
     ax.legend(fontsize=8)
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
-def track_lengths(lengths: Mapping[str, Mapping[float, Sequence[int]]]) -> str:
+def track_lengths(lengths: Mapping[str, Mapping[float, Sequence[int]]]) -> bytes:
     """Frames each distinct track is visible, per classifier memory (the thesis' Figure 7.7).
 
     One panel per sequence; within it, one group of bars per memory, tracks sorted
@@ -325,7 +331,7 @@ def track_lengths(lengths: Mapping[str, Mapping[float, Sequence[int]]]) -> str:
         "frames each distinct track remains (classifier memory; number of tracks)", fontsize=9
     )
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
 def stacked_stages(
@@ -335,7 +341,7 @@ def stacked_stages(
     xlabel: str,
     title: str,
     limit_ms: float | None = None,
-) -> str:
+) -> bytes:
     """Stacked bars of milliseconds per stage (one bar per group), with an optional limit line."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(7.5, 4.0), dpi=DPI)
@@ -352,10 +358,12 @@ def stacked_stages(
     ax.legend(fontsize=7, ncol=3, loc="upper left")
     ax.grid(True, axis="y", alpha=0.3)
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)
 
 
-def stage_bars(stage_ms: Mapping[str, float], total_ms: float, floor_ms: float, title: str) -> str:
+def stage_bars(
+    stage_ms: Mapping[str, float], total_ms: float, floor_ms: float, title: str
+) -> bytes:
     """Horizontal bars of ms per frame per stage, the pipeline total, and the decode floor."""
     plt = pyplot()
     names = [*stage_ms, "pipeline (total)", "decode alone (floor)"]
@@ -373,4 +381,4 @@ def stage_bars(stage_ms: Mapping[str, float], total_ms: float, floor_ms: float, 
     ax.set_title(title, fontsize=9)
     ax.grid(True, axis="x", alpha=0.3)
     fig.tight_layout()
-    return figure_uri(fig)
+    return figure_png(fig)

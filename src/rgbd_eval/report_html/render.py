@@ -59,11 +59,6 @@ def data_uri(data: bytes, mime: str = "image/png") -> str:
     return f"data:{mime};base64," + base64.b64encode(data).decode("ascii")
 
 
-def figure_uri(fig: Figure) -> str:
-    """A matplotlib figure as a PNG ``data:`` URI; the figure is closed."""
-    return data_uri(figure_png(fig))
-
-
 def jpeg_uri(rgb: NDArray[np.uint8]) -> str:
     """An RGB image (H x W x 3) as a JPEG ``data:`` URI."""
     import cv2
