@@ -355,7 +355,7 @@ def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> 
                 str(spec.get("param", "value")),
                 [float(n) for n in names],
                 [dict(_paper_row(measured, n) or {}) for n in names],
-                f"{spec['title']}: paper (dashed) and measured (solid)",
+                "paper (dashed) and measured (solid)",
                 paper=[_paper_row(spec["rows"], n) for n in names],
             )
         else:
@@ -386,7 +386,7 @@ def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> 
             stages,
             ms,
             "voxel size (m)",
-            "detection time per stage (one core)",
+            "detection time per stage (one core); the line is one frame at 30 Hz",
             limit_ms=1000.0 / 30.0,
         )
         figures.append(

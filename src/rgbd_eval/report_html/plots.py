@@ -144,7 +144,7 @@ def indicator_curves(
     """
     plt = pyplot()
     xs, labels = _positions(values)
-    fig, ax = plt.subplots(figsize=(7.5, 4.2), dpi=DPI)
+    fig, ax = plt.subplots(figsize=(7.5, 4.8 if paper is not None else 4.4), dpi=DPI)
     ax2 = ax.twinx()
     colours = {"mota": "tab:blue", "fp_rate": "tab:purple", "fn_rate": "tab:orange"}
     series: list[tuple[str, Sequence[Mapping[str, Any]], str]] = [("measured", summaries, "-")]
@@ -165,7 +165,7 @@ def indicator_curves(
         ax.set_xticks(xs, labels)
     h1, l1 = ax.get_legend_handles_labels()
     h2, l2 = ax2.get_legend_handles_labels()
-    ax.legend(h1 + h2, l1 + l2, fontsize=7, loc="best", ncol=2)
+    ax.legend(h1 + h2, l1 + l2, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=4)
     ax.grid(True, alpha=0.3)
     ax.set_title(title)
     fig.tight_layout()
@@ -351,7 +351,7 @@ def stacked_stages(
         ax.bar(groups, vals, bottom=bottom, label=stage, color=f"C{k % 10}")
         bottom += vals
     if limit_ms is not None:
-        ax.axhline(limit_ms, color="red", ls="--", lw=1, label=f"{limit_ms:g} ms")
+        ax.axhline(limit_ms, color="red", ls="--", lw=1, label=f"{limit_ms:.1f} ms")
     ax.set_xlabel(xlabel)
     ax.set_ylabel("ms per frame")
     ax.set_title(title)
