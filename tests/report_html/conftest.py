@@ -15,8 +15,9 @@ from rgbd_eval.compare import compare_reports
 from rgbd_eval.config import Gating
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.metrics import Counts
+from rgbd_eval.plugins import ReproduceResult
 from rgbd_eval.report_html import bench_page, compare_page, reproduce_page, write_sweep_html
-from rgbd_eval.reproduce import Claim, Reproduction, paper_values
+from rgbd_eval.reproduce import Claim, Reproduction, to_json
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import SweepRecord, SweepResult
 
@@ -85,8 +86,8 @@ def sweep_result() -> SweepResult:
     return SweepResult(tuple(grid[0]), tuple(grid), records, 1.0, 1.0, 0, 1)
 
 
-def reproduction() -> Reproduction:
-    """Tables 7.2 and 7.6 (three thresholds), Figures 7.7 and 7.9, two claims."""
+def reproduction() -> ReproduceResult:
+    """basso2012's result with Tables 7.2 and 7.6 (three thresholds), Figures 7.7 and 7.9, two claims."""
     res = Reproduction(seconds=12.0)
     summary = {"motp": 0.8, "mota": 0.85, "fp_rate": 0.05, "fn_rate": 0.1, "id_switches": 2}
     summary |= {"main_tr": 0.7, "all_tr": 0.9}
@@ -105,7 +106,8 @@ def reproduction() -> Reproduction:
         Claim("7.3, Table 7.6", "FN rise for thresholds above -0.5", True, "FN 10% -> 20%"),
         Claim("7.1, Figure 7.7", "fewer tracks with memory", False, "4 vs 2"),
     ]
-    return res
+    claims = tuple((c.text, c.held) for c in res.claims)
+    return ReproduceResult(markdown="", data=to_json(res), claims=claims)
 
 
 def bench_result() -> BenchResult:
@@ -146,7 +148,7 @@ def pages(run_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, 
     metrics["fn_rate"] = max(0.0, metrics["fn_rate"] - 0.05)  # better by 5 points
     comparison = compare_reports(baseline, current)
     (out / "compare.html").write_text(compare_page(comparison, "base.json", "current.json"))
-    (out / "reproduce.html").write_text(reproduce_page(reproduction(), paper_values(), "basso2012"))
+    (out / "reproduce.html").write_text(reproduce_page(reproduction(), "basso2012"))
     (out / "bench.html").write_text(bench_page(bench_result(), STAGE_LABELS))
     return {
         "run": run_dir / "report.html",

@@ -7,7 +7,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rgbd_eval.config import IoConfig
 from rgbd_eval.errors import OutputError
 from rgbd_eval.metrics import FrameEvents, Match
 from rgbd_eval.report_html.overlay import GT_COLOUR, MISS_COLOUR, draw_frame, track_colour
@@ -63,7 +62,8 @@ def test_unwritable_video_is_an_output_error(recording: Path, tmp_path: Path) ->
     from rgbd_eval.config import load_config
     from rgbd_eval.pipeline import run_sequence
 
-    result = run_sequence(recording, load_config(method="basso2012"))
+    config = load_config(method="basso2012")
+    result = run_sequence(recording, config)
     target = tmp_path / "missing" / "folder" / "x.mp4"
     with pytest.raises(OutputError, match=r"x\.mp4: OpenCV cannot write MP4"):
-        write_overlay_video(target, result, IoConfig())
+        write_overlay_video(target, result, config)

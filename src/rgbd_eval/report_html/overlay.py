@@ -15,10 +15,11 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import IoConfig
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.config import RunConfig
+from rgbd_eval.errors import OutputError
 from rgbd_eval.metrics import FrameEvents
 from rgbd_eval.metrics.selection import is_scored_track
+from rgbd_eval.pipeline import open_for
 from rgbd_eval.types import Box2D, Frame, GroundTruthObject, TrackOutput, Visibility
 
 RGB = tuple[int, int, int]
@@ -43,25 +44,36 @@ def track_colour(track_id: int) -> RGB:
     return _TRACK_COLOURS[track_id % len(_TRACK_COLOURS)]
 
 
-def rgb_of(frame: Frame) -> NDArray[np.uint8]:
-    """The frame's colour image (H x W x 3, RGB order); the one place that knows the Frame layout."""
-    return frame.rgb
+def rgb_of(frame: Frame) -> NDArray[np.uint8] | None:
+    """The frame's colour image (H x W x 3, RGB order), None without a colour stream.
+
+    The one place that knows where a Frame keeps its colour image.
+    """
+    stream = frame.streams.get("colour")
+    return None if stream is None else stream.image
 
 
 def rgb_frames(
-    path: Path, io: IoConfig, wanted: Sequence[int] | None = None
+    path: Path, config: RunConfig, wanted: Sequence[int] | None = None
 ) -> Iterator[tuple[int, NDArray[np.uint8]]]:
     """``(index, rgb)`` of the recording's frames (only ``wanted`` ones if given), in order.
 
-    Re-reads the recording; stops after the last wanted frame.
+    Re-reads the recording with the streams of the configured method, so the frame
+    indices are those of the run; stops after the last wanted frame. Raises
+    OutputError when the method reads no colour stream (nothing to draw on).
     """
     keep = None if wanted is None else set(wanted)
     if keep is not None and not keep:
         return
     last = None if keep is None else max(keep)
-    for index, frame in enumerate(open_recording(path, io).frames()):
+    for index, frame in enumerate(open_for(path, config).frames()):
         if keep is None or index in keep:
-            yield index, rgb_of(frame)
+            rgb = rgb_of(frame)
+            if rgb is None:
+                raise OutputError(
+                    path, f"method {config.method!r} reads no colour stream to draw tracks on"
+                )
+            yield index, rgb
         if last is not None and index >= last:
             return
 

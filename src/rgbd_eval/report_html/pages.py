@@ -30,7 +30,7 @@ from rgbd_eval.report_html.video import Progress, overlay, write_overlay_video
 if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
     from rgbd_eval.compare import Comparison
-    from rgbd_eval.reproduce import Reproduction
+    from rgbd_eval.plugins import ReproduceResult
     from rgbd_eval.sweep import Point, SweepResult
 
 #: Frames in the worst-frame strip of each sequence.
@@ -172,12 +172,10 @@ def write_run_html(
         video_name = None
         if video:
             video_name = f"{r.name}.overlay.mp4"
-            made = write_overlay_video(folder / video_name, r, config.io, worst, progress)
+            made = write_overlay_video(folder / video_name, r, config, worst, progress)
             images = made.kept
         else:
-            images = {
-                i: overlay(r, i, rgb) for i, rgb in rgb_frames(Path(r.path), config.io, worst)
-            }
+            images = {i: overlay(r, i, rgb) for i, rgb in rgb_frames(Path(r.path), config, worst)}
         sections.append(_section(folder, r, images, worst, video_name))
     write_text(folder / "report.html", run_page(results, config, report, sections))
 
@@ -331,60 +329,75 @@ def _cell(value: Any, key: str) -> str:
     return str(int(value)) if key == "id_switches" else f"{100 * float(value):.1f}%"
 
 
-def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> str:
-    """``reproduce.html``: per table the paper's value beside ours, the claims, the figures redrawn."""
+@dataclass(frozen=True)
+class ClaimRow:
+    """One claim of the paper on the page."""
+
+    text: str
+    held: bool
+    source: str = ""
+    evidence: str = ""
+
+
+def paper_file(method: str) -> dict[str, Any] | None:
+    """The published numbers of ``method``'s paper (``configs/papers/<method>.yaml``), if any."""
+    from rgbd_eval.config import config_dir
+    from rgbd_eval.reproduce import paper_values
+
+    path = config_dir() / "papers" / f"{method}.yaml"
+    return paper_values(path) if path.is_file() else None
+
+
+def _claims(result: ReproduceResult) -> list[ClaimRow]:
+    """The result's claims, with source and evidence where its data records them."""
+    details = {
+        str(c.get("text")): c for c in result.data.get("claims", []) if isinstance(c, Mapping)
+    }
+    rows = []
+    for text, held in result.claims:
+        d = details.get(text, {})
+        rows.append(ClaimRow(text, held, str(d.get("source", "")), str(d.get("evidence", ""))))
+    return rows
+
+
+def reproduce_page(
+    result: ReproduceResult, method: str, paper: Mapping[str, Any] | None = None
+) -> str:
+    """``reproduce.html``: per table the paper's value beside ours, the claims, the figures redrawn.
+
+    Reads the result's JSON data: ``tables`` (table -> row -> measured summary) beside
+    the paper's tables of the same keys (``paper``, by default ``configs/papers/<method>.yaml``);
+    ``track_lengths`` and ``voxel_timing_ms`` where the paper has those figures (basso2012's
+    Figures 7.7 and 7.9).
+    """
+    paper = paper if paper is not None else (paper_file(method) or {})
+    data = result.data
     tables = []
-    for tab, measured in res.tables.items():
+    for tab, measured in dict(data.get("tables", {})).items():
         spec = paper.get("tables", {}).get(tab)
         if spec is None:
             continue
-        names = [str(k).lower() for k in spec["rows"]]
-        names += [n for n in measured if _paper_row(spec["rows"], n) is None]
-        cols = [
-            (k, h) for k, h, _ in SHORT_COLUMNS if any(k in dict(v) for v in spec["rows"].values())
-        ]
-        rows = []
-        for name in names:
-            p, o = _paper_row(spec["rows"], name), _paper_row(measured, name)
-            rows.append(
-                (name, [(_cell((p or {}).get(k), k), _cell((o or {}).get(k), k)) for k, _ in cols])
-            )
-        numeric = _all_numeric(names)
-        if numeric and len(names) >= 3:
-            figure = plots.indicator_curves(
-                str(spec.get("param", "value")),
-                [float(n) for n in names],
-                [dict(_paper_row(measured, n) or {}) for n in names],
-                "paper (dashed) and measured (solid)",
-                paper=[_paper_row(spec["rows"], n) for n in names],
-            )
-        else:
-            figure = plots.paper_vs_measured(
-                names,
-                [_float_or_none((_paper_row(spec["rows"], n) or {}).get("mota")) for n in names],
-                [_float_or_none((_paper_row(measured, n) or {}).get("mota")) for n in names],
-                "MOTA",
-                spec["title"],
-            )
-        tables.append((spec["title"], [h for _, h in cols], rows, data_uri(figure)))
+        tables.append(_reproduced_table(spec, measured))
     figures = []
-    if res.track_lengths:
-        text = paper.get("figures", {}).get("7.7", "")
+    lengths = data.get("track_lengths") or {}
+    if lengths:
+        by_memory = {
+            name: {float(m): list(v) for m, v in per.items()} for name, per in lengths.items()
+        }
         figures.append(
             (
                 "Figure 7.7: frames each distinct track remains",
-                data_uri(plots.track_lengths(res.track_lengths)),
-                text,
+                data_uri(plots.track_lengths(by_memory)),
+                paper.get("figures", {}).get("7.7", ""),
             )
         )
-    if res.voxel_timing:
-        stages = [s for s in next(iter(res.voxel_timing.values())) if s != "total_detect"]
-        groups = [f"{v:.2f}" for v in res.voxel_timing]
-        ms = [[t[s] for s in stages] for t in res.voxel_timing.values()]
+    timing = data.get("voxel_timing_ms") or {}
+    if timing:
+        stages = [s for s in next(iter(timing.values())) if s != "total_detect"]
         figure = plots.stacked_stages(
-            groups,
+            [f"{float(v):.2f}" for v in timing],
             stages,
-            ms,
+            [[t[s] for s in stages] for t in timing.values()],
             "voxel size (m)",
             "detection time per stage (one core); the line is one frame at 30 Hz",
             limit_ms=1000.0 / 30.0,
@@ -401,11 +414,45 @@ def reproduce_page(res: Reproduction, paper: Mapping[str, Any], method: str) -> 
         title=f"rgbd-eval reproduce {method}",
         method=method,
         source=paper.get("source", ""),
-        seconds=res.seconds,
+        seconds=float(data.get("seconds", 0.0)),
         tables=tables,
         figures=figures,
-        claims=res.claims,
+        claims=_claims(result),
     )
+
+
+def _reproduced_table(
+    spec: Mapping[str, Any], measured: Mapping[str, Any]
+) -> tuple[str, list[str], list[tuple[str, list[tuple[str, str]]]], str]:
+    """(title, column headers, rows of (name, [(paper, measured)]), figure) of one table.
+
+    The figure: indicator curves, paper dashed, for a swept number (three rows or more
+    with numeric names, as Table 7.6 / Figure 7.10); else MOTA bars, paper beside measured.
+    """
+    names = [str(k).lower() for k in spec["rows"]]
+    names += [n for n in measured if _paper_row(spec["rows"], n) is None]
+    cols = [(k, h) for k, h, _ in SHORT_COLUMNS if any(k in dict(v) for v in spec["rows"].values())]
+    rows = []
+    for name in names:
+        p, o = _paper_row(spec["rows"], name) or {}, _paper_row(measured, name) or {}
+        rows.append((name, [(_cell(p.get(k), k), _cell(o.get(k), k)) for k, _ in cols]))
+    if _all_numeric(names) and len(names) >= 3:
+        figure = plots.indicator_curves(
+            str(spec.get("param", "value")),
+            [float(n) for n in names],
+            [dict(_paper_row(measured, n) or {}) for n in names],
+            "paper (dashed) and measured (solid)",
+            paper=[_paper_row(spec["rows"], n) for n in names],
+        )
+    else:
+        figure = plots.paper_vs_measured(
+            names,
+            [_float_or_none((_paper_row(spec["rows"], n) or {}).get("mota")) for n in names],
+            [_float_or_none((_paper_row(measured, n) or {}).get("mota")) for n in names],
+            "MOTA",
+            spec["title"],
+        )
+    return spec["title"], [h for _, h in cols], rows, data_uri(figure)
 
 
 def _all_numeric(names: Sequence[str]) -> bool:

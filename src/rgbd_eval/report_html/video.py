@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import IoConfig
+from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import OutputError
 from rgbd_eval.pipeline import SequenceResult
 from rgbd_eval.report_html.events import frame_errors
@@ -54,7 +54,7 @@ def overlay(result: SequenceResult, index: int, rgb: NDArray[np.uint8]) -> NDArr
 def write_overlay_video(
     path: Path,
     result: SequenceResult,
-    io: IoConfig,
+    config: RunConfig,
     keep: Sequence[int] = (),
     progress: Progress | None = None,
 ) -> VideoResult:
@@ -72,7 +72,7 @@ def write_overlay_video(
     wanted = set(keep)
     written = 0
     try:
-        for index, rgb in rgb_frames(Path(result.path), io):
+        for index, rgb in rgb_frames(Path(result.path), config):
             if index >= total:
                 break
             image = overlay(result, index, rgb)
