@@ -16,7 +16,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.config import RunConfig
-from rgbd_eval.errors import OutputError
 from rgbd_eval.metrics import FrameEvents
 from rgbd_eval.metrics.selection import is_scored_track
 from rgbd_eval.pipeline import open_for
@@ -55,12 +54,12 @@ def rgb_of(frame: Frame) -> NDArray[np.uint8] | None:
 
 def rgb_frames(
     path: Path, config: RunConfig, wanted: Sequence[int] | None = None
-) -> Iterator[tuple[int, NDArray[np.uint8]]]:
+) -> Iterator[tuple[int, NDArray[np.uint8] | None]]:
     """``(index, rgb)`` of the recording's frames (only ``wanted`` ones if given), in order.
 
     Re-reads the recording with the streams of the configured method, so the frame
-    indices are those of the run; stops after the last wanted frame. Raises
-    OutputError when the method reads no colour stream (nothing to draw on).
+    indices are those of the run; stops after the last wanted frame. ``rgb`` is None
+    where the frame has no colour stream (a depth-only method reads none).
     """
     keep = None if wanted is None else set(wanted)
     if keep is not None and not keep:
@@ -68,12 +67,7 @@ def rgb_frames(
     last = None if keep is None else max(keep)
     for index, frame in enumerate(open_for(path, config).frames()):
         if keep is None or index in keep:
-            rgb = rgb_of(frame)
-            if rgb is None:
-                raise OutputError(
-                    path, f"method {config.method!r} reads no colour stream to draw tracks on"
-                )
-            yield index, rgb
+            yield index, rgb_of(frame)
         if last is not None and index >= last:
             return
 

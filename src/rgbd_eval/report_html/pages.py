@@ -69,6 +69,8 @@ class SequenceSection:
     shots: tuple[Shot, ...]
     error_frames: int
     video: str | None
+    #: Worst frames that could not be shown: the recording was read without colour.
+    no_colour: int = 0
 
 
 def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
@@ -115,9 +117,10 @@ def _section(
     errors = frame_errors(r.scores.frames)
     shots = []
     for i in worst:
-        e = errors[i]
-        caption = f"frame {i}: {e.fp} FP, {e.fn} FN, {e.id_switches} ID switch(es)"
-        shots.append(Shot(i, jpeg_uri(images[i]), caption))
+        if i in images:
+            e = errors[i]
+            caption = f"frame {i}: {e.fp} FP, {e.fn} FN, {e.id_switches} ID switch(es)"
+            shots.append(Shot(i, jpeg_uri(images[i]), caption))
     return SequenceSection(
         r.name,
         birds_eye,
@@ -125,6 +128,7 @@ def _section(
         tuple(shots),
         sum(e.total > 0 for e in errors),
         video,
+        no_colour=len(worst) - len(shots),
     )
 
 
@@ -175,7 +179,11 @@ def write_run_html(
             made = write_overlay_video(folder / video_name, r, config, worst, progress)
             images = made.kept
         else:
-            images = {i: overlay(r, i, rgb) for i, rgb in rgb_frames(Path(r.path), config, worst)}
+            images = {
+                i: overlay(r, i, rgb)
+                for i, rgb in rgb_frames(Path(r.path), config, worst)
+                if rgb is not None
+            }
         sections.append(_section(folder, r, images, worst, video_name))
     write_text(folder / "report.html", run_page(results, config, report, sections))
 

@@ -75,6 +75,10 @@ def write_overlay_video(
         for index, rgb in rgb_frames(Path(result.path), config):
             if index >= total:
                 break
+            if rgb is None:
+                raise OutputError(
+                    path, f"method {config.method!r} reads no colour stream to draw the video on"
+                )
             image = overlay(result, index, rgb)
             if writer is None:
                 height, width = image.shape[:2]
