@@ -87,7 +87,8 @@ def birds_eye(
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize=7, loc="best", ncol=2)
-    fig.tight_layout()
+    # Fixed margins: tight_layout would cost a third of the page's time on the demo.
+    fig.subplots_adjust(left=0.1, right=0.97, bottom=0.09, top=0.94)
     return figure_png(fig)
 
 
@@ -119,7 +120,7 @@ def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> bytes:
     ax.yaxis.get_major_locator().set_params(integer=True)
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.0, 1.0))
-    fig.tight_layout()
+    fig.subplots_adjust(left=0.06, right=0.87, bottom=0.17, top=0.95)
     return figure_png(fig)
 
 
