@@ -139,3 +139,13 @@ def test_reproduce_page_shows_paper_beside_measured_and_claims(pages: dict[str, 
     # Table 7.6 at -1.0: the thesis' FP 4.4% beside our 8.0%.
     assert "4.4% / <b>8.0%</b>" in html
     assert html.count('class="left held"') == 1 and html.count('class="left failed"') == 1
+
+
+def test_config_diff_lists_only_what_differs_from_the_method_defaults() -> None:
+    from rgbd_eval.config import load_config
+    from rgbd_eval.report_html.pages import config_diff
+
+    assert config_diff(load_config(method="basso2012")) == []
+    changed = load_config(None, ["tracker.min_confidence=-1.0"], method="basso2012")
+    # configs/methods/basso2012.yaml keeps Table 6.1's -0.5
+    assert config_diff(changed) == [("tracker.min_confidence", -0.5, -1.0)]

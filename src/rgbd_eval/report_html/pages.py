@@ -17,10 +17,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.atomic import write_bytes, write_text
+from rgbd_eval.compare import flatten
 from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
 from rgbd_eval.metrics import Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
-from rgbd_eval.report import format_value, run_notes, table_header, table_rows
+from rgbd_eval.report import COLUMNS, format_value, run_notes, table_header, table_rows
 from rgbd_eval.report_html import plots
 from rgbd_eval.report_html.events import frame_errors, markers, worst_frames
 from rgbd_eval.report_html.overlay import rgb_frames
@@ -35,16 +36,8 @@ if TYPE_CHECKING:
 
 #: Frames in the worst-frame strip of each sequence.
 WORST_FRAMES = 6
-#: Columns of the short metric tables (sweep, reproduce): (key, header, kind as in report.COLUMNS).
-SHORT_COLUMNS = (
-    ("motp", "MOTP", "motp"),
-    ("mota", "MOTA", "pct"),
-    ("fp_rate", "FP", "pct"),
-    ("fn_rate", "FN", "pct"),
-    ("id_switches", "ID Sw.", "int"),
-    ("main_tr", "Main Tr.", "pct"),
-    ("all_tr", "All Tr.", "pct"),
-)
+#: Columns of the short metric tables (sweep, reproduce): those of the thesis' Tables 7.2-7.6.
+SHORT_COLUMNS = COLUMNS[:7]
 
 
 # ----------------------------------------------------------------------------- run
@@ -73,20 +66,12 @@ class SequenceSection:
     no_colour: int = 0
 
 
-def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
-    if isinstance(value, Mapping):
-        for k, v in value.items():
-            _flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
-    else:
-        out[prefix] = value
-
-
 def config_diff(config: RunConfig) -> list[tuple[str, Any, Any]]:
     """``(key, method default, used)`` for every config value that differs from the method's file."""
     defaults: dict[str, Any] = {}
     used: dict[str, Any] = {}
-    _flatten("", config_to_dict(load_config(method=config.method)), defaults)
-    _flatten("", config_to_dict(config), used)
+    flatten("", config_to_dict(load_config(method=config.method)), defaults)
+    flatten("", config_to_dict(config), used)
     return [
         (k, defaults.get(k), used.get(k))
         for k in sorted(set(defaults) | set(used))
