@@ -43,6 +43,23 @@ def run_dir(recording: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
+@pytest.fixture(scope="session")
+def score_dir(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """``rgbd-eval score`` of MOTChallenge files: person 1 tracked, then lost, then an id switch."""
+    folder = tmp_path_factory.mktemp("html_score")
+    # frame,id,x,y,w,h,consider,class,visibility: person 1 in frames 1-4.
+    (folder / "gt.txt").write_text("".join(f"{f},1,0,0,10,10,1,1,1.0\n" for f in range(1, 5)))
+    # frame,id,x,y,w,h,...: track 7 on it in frames 1-2, nothing in 3 (a miss), track 8 in 4
+    # (an id switch); track 9 far away in frame 1 (a false positive).
+    rows = ["1,7,0,0,10,10", "1,9,50,50,10,10", "2,7,0,0,10,10", "4,8,0,0,10,10"]
+    (folder / "tracks.txt").write_text("".join(r + ",-1,-1,-1,-1\n" for r in rows))
+    out = folder / "out"
+    args = ["score", str(folder / "tracks.txt"), "--gt", str(folder / "gt.txt"), "--out", str(out)]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    return out
+
+
 def counts(fp: int, fn: int, id_switches: int, matches: int = 90) -> Counts:
     """Consistent counts of a 100-instance, 50-frame sequence: matches + fn = 100 ground truth."""
     return Counts(
@@ -137,7 +154,9 @@ def bench_result() -> BenchResult:
 
 
 @pytest.fixture(scope="session")
-def pages(run_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, Path]:
+def pages(
+    run_dir: Path, score_dir: Path, tmp_path_factory: pytest.TempPathFactory
+) -> dict[str, Path]:
     """Every page: the run's report.html, and sweep, compare, reproduce and bench pages."""
     out = tmp_path_factory.mktemp("html_pages")
     write_sweep_html(out, sweep_result(), "basso2012", ["short.mcap"], [], Gating.IOU)
@@ -152,6 +171,7 @@ def pages(run_dir: Path, tmp_path_factory: pytest.TempPathFactory) -> dict[str, 
     (out / "bench.html").write_text(bench_page(bench_result(), STAGE_LABELS))
     return {
         "run": run_dir / "report.html",
+        "score": score_dir / "report.html",
         "sweep": out / "sweep.html",
         "compare": out / "compare.html",
         "reproduce": out / "reproduce.html",

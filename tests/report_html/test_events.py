@@ -2,10 +2,11 @@
 
 from __future__ import annotations
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from rgbd_eval.config import EvaluationConfig
+from rgbd_eval.config import Convention, EvaluationConfig
 from rgbd_eval.metrics import FrameEvents, Match, evaluate_sequence
 from rgbd_eval.report_html.events import (
     FrameErrors,
@@ -31,8 +32,9 @@ def _events(
     )
 
 
-# gt 1: matched (track 10), missed, matched again by track 12 (an id switch), missed at the end.
-# gt 2: missed, then matched by track 11 twice, then gone. Track 20 is a false positive in frame 0.
+# gt 1: matched (track 10), missed, matched again by track 12 (an id switch), missed at the end
+# in a frame without tracks. gt 2: missed, then matched by track 11 twice, then gone. Track 20
+# is a false positive in frame 0.
 FRAMES = [
     _events(0, [(1, 10, False)], [2], [20]),
     _events(1, [(2, 11, False)], [1], []),
@@ -51,15 +53,37 @@ def test_frame_errors_count_fp_fn_and_switches() -> None:
     assert [e.total for e in frame_errors(FRAMES)] == [2, 1, 1, 1]
 
 
-def test_markers_follow_motmetrics_fragmentation_definition() -> None:
-    # gt 1 states: matched(0), missed(1), matched(2), missed(3). Within the span from its first
-    # to its last match (frames 0..2) it goes matched -> missed once, at frame 1: one
-    # fragmentation. The miss at frame 3 is after its last match: none. gt 2: missed(0) before
-    # its first match, then matched(1), matched(2): none. The switch is at frame 2, gt 1.
-    assert markers(FRAMES) == [
-        Marker(1, 1, MarkerKind.FRAGMENTATION),
+@pytest.mark.parametrize("convention", list(Convention))
+def test_markers_of_an_interrupted_and_switched_object(convention: Convention) -> None:
+    # gt 1: matched (track 10) in frame 0, missed in 1, matched again in 2 by track 12.
+    # motchallenge: its second tracked stretch starts at frame 2 (frame 1 was scored: it
+    # has ground truth and track 11). motmetrics: it returns from missed at frame 2. Frame 3
+    # (a miss after the last match, no tracks) adds nothing in either. gt 2's miss in frame
+    # 0 is before its first match: nothing. The id switch is at frame 2, gt 1.
+    assert markers(FRAMES, convention) == [
+        Marker(2, 1, MarkerKind.FRAGMENTATION),
         Marker(2, 1, MarkerKind.ID_SWITCH),
     ]
+
+
+def test_fragmentation_conventions_differ_where_documented() -> None:
+    absent = [  # gt 1 absent from frame 1, which is scored (gt 2 and track 11 are there)
+        _events(0, [(1, 10, False)], [], []),
+        _events(1, [(2, 11, False)], [], []),
+        _events(2, [(1, 10, False)], [], []),
+    ]
+    # motchallenge breaks the stretch at any scored frame without a match, absent included.
+    assert markers(absent, Convention.MOTCHALLENGE) == [Marker(2, 1, MarkerKind.FRAGMENTATION)]
+    # motmetrics looks only at the frames the object is present in: it was never missed.
+    assert markers(absent, Convention.MOTMETRICS) == []
+    no_tracks = [  # gt 1 missed in frame 1, which has no track at all
+        _events(0, [(1, 10, False)], [], []),
+        _events(1, [], [1], []),
+        _events(2, [(1, 10, False)], [], []),
+    ]
+    # motchallenge's matcher skips a frame without tracks: the stretch goes on.
+    assert markers(no_tracks, Convention.MOTCHALLENGE) == []
+    assert markers(no_tracks, Convention.MOTMETRICS) == [Marker(2, 1, MarkerKind.FRAGMENTATION)]
 
 
 def _totals(*totals: int) -> list[FrameErrors]:
@@ -103,15 +127,16 @@ def sequences(draw: st.DrawFn) -> tuple[list[list[GroundTruthObject]], list[list
     return gts, tracks
 
 
+@pytest.mark.parametrize("convention", list(Convention))
 @settings(max_examples=80, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=sequences())
 def test_event_totals_equal_the_scored_counts(
-    data: tuple[list[list[GroundTruthObject]], list[list[TrackOutput]]],
+    convention: Convention, data: tuple[list[list[GroundTruthObject]], list[list[TrackOutput]]]
 ) -> None:
     gts, tracks = data
-    scores = evaluate_sequence(gts, tracks, EvaluationConfig())
+    scores = evaluate_sequence(gts, tracks, EvaluationConfig(convention=convention))
     errors = frame_errors(scores.frames)
-    marks = markers(scores.frames)
+    marks = markers(scores.frames, convention)
     c = scores.counts
     assert sum(e.fp for e in errors) == c.fp
     assert sum(e.fn for e in errors) == c.fn

@@ -93,7 +93,7 @@ def test_run_writes_html_plots_and_video_beside_the_report(run_dir: Path) -> Non
     assert 'href="short.overlay.mp4"' in html
 
 
-@pytest.mark.parametrize("page", ["run", "sweep", "compare", "reproduce", "bench"])
+@pytest.mark.parametrize("page", ["run", "score", "sweep", "compare", "reproduce", "bench"])
 def test_page_is_self_contained_and_its_images_decode(pages: dict[str, Path], page: str) -> None:
     html = pages[page].read_text(encoding="utf-8")
     assert html.startswith("<!DOCTYPE html>")
@@ -149,3 +149,13 @@ def test_config_diff_lists_only_what_differs_from_the_method_defaults() -> None:
     changed = load_config(None, ["tracker.min_confidence=-1.0"], method="basso2012")
     # configs/methods/basso2012.yaml keeps Table 6.1's -0.5
     assert config_diff(changed) == [("tracker.min_confidence", -0.5, -1.0)]
+
+
+def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) -> None:
+    html = pages["score"].read_text()
+    # 4 ground-truth instances: 1 FP (track 9), 1 FN (frame 3), 1 ID switch (frame 4):
+    # MOTA = 1 - 3/4 = 25.0%; no world positions, so no bird's-eye plot and no images.
+    assert "<td>25.0%</td>" in html
+    assert "bird&#39;s-eye" not in html and "image/jpeg" not in html
+    assert html.count("<img ") == 1  # the error timeline
+    assert not (pages["score"].parent / "tracks.birdseye.png").exists()

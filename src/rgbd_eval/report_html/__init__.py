@@ -7,6 +7,7 @@ from rgbd_eval.report_html.pages import (
     run_page,
     sweep_page,
     write_run_html,
+    write_score_html,
     write_sweep_html,
 )
 
@@ -17,5 +18,6 @@ __all__ = [
     "run_page",
     "sweep_page",
     "write_run_html",
+    "write_score_html",
     "write_sweep_html",
 ]

@@ -2,18 +2,23 @@
 
 Counts here equal those of :class:`rgbd_eval.metrics.Counts`: the FP, FN and
 id switches of :func:`frame_errors` sum to ``fp``, ``fn`` and ``id_switches``, and
-the fragmentation markers of :func:`markers` number ``fragmentations`` (motmetrics'
-definition: within the span from an object's first to its last match, each change
-from matched to missed).
+the fragmentation markers of :func:`markers` number ``fragmentations`` under either
+convention (see :mod:`rgbd_eval.metrics.clear`):
+
+- ``motchallenge``: an object's tracked stretches after its first; a stretch breaks
+  at any scored frame (one with ground truth and tracks) where the object is not
+  matched, absent included. Marked where a later stretch starts.
+- ``motmetrics``: over the frames the object is present in, each return from missed
+  to matched. Marked at the return.
 """
 
 from __future__ import annotations
 
 import enum
-import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from rgbd_eval.config import Convention
 from rgbd_eval.metrics import FrameEvents
 
 
@@ -59,30 +64,49 @@ def frame_errors(frames: Sequence[FrameEvents]) -> list[FrameErrors]:
     ]
 
 
-def markers(frames: Sequence[FrameEvents]) -> list[Marker]:
-    """Id switches (at the switching match) and fragmentations (at the first missed frame)."""
+def markers(frames: Sequence[FrameEvents], convention: Convention) -> list[Marker]:
+    """Id switches (at the switching match) and fragmentations (at the frame that resumes)."""
     out = [
         Marker(f.frame, m.gt_id, MarkerKind.ID_SWITCH)
         for f in frames
         for m in f.matches
         if m.id_switch
     ]
-    # Per object, its scored frames in order: (frame, matched?).
-    history: dict[int, list[tuple[int, bool]]] = {}
+    if convention is Convention.MOTCHALLENGE:
+        out += _motchallenge_fragmentations(frames)
+    else:
+        out += _motmetrics_fragmentations(frames)
+    return sorted(out, key=lambda m: (m.frame, m.gt_id, m.kind.value))
+
+
+def _motchallenge_fragmentations(frames: Sequence[FrameEvents]) -> list[Marker]:
+    out = []
+    previous: set[int] = set()  # objects matched in the previous scored frame
+    started: set[int] = set()  # objects tracked at least once
+    for f in frames:
+        if not (f.matches or f.misses) or not (f.matches or f.false_positives):
+            continue  # no scored ground truth or no scored track: the matcher skips the frame
+        matched = {m.gt_id for m in f.matches}
+        for gt_id in sorted(matched - previous):
+            if gt_id in started:
+                out.append(Marker(f.frame, gt_id, MarkerKind.FRAGMENTATION))
+            started.add(gt_id)
+        previous = matched
+    return out
+
+
+def _motmetrics_fragmentations(frames: Sequence[FrameEvents]) -> list[Marker]:
+    out = []
+    tracked: set[int] = set()  # objects matched at least once
+    lost: set[int] = set()  # of those, missed since their last match
     for f in frames:
         for m in f.matches:
-            history.setdefault(m.gt_id, []).append((f.frame, True))
-        for gt_id in f.misses:
-            history.setdefault(gt_id, []).append((f.frame, False))
-    for gt_id, states in history.items():
-        matched_at = [i for i, (_, matched) in enumerate(states) if matched]
-        if not matched_at:
-            continue
-        span = states[matched_at[0] : matched_at[-1] + 1]
-        for (_, before), (frame, now) in itertools.pairwise(span):
-            if before and not now:
-                out.append(Marker(frame, gt_id, MarkerKind.FRAGMENTATION))
-    return sorted(out, key=lambda m: (m.frame, m.gt_id, m.kind.value))
+            if m.gt_id in lost:
+                out.append(Marker(f.frame, m.gt_id, MarkerKind.FRAGMENTATION))
+                lost.discard(m.gt_id)
+            tracked.add(m.gt_id)
+        lost |= tracked.intersection(f.misses)
+    return out
 
 
 def worst_frames(errors: Sequence[FrameErrors], count: int) -> list[int]:

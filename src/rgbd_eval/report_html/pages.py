@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from rgbd_eval.atomic import write_bytes, write_text
 from rgbd_eval.compare import flatten
 from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
-from rgbd_eval.metrics import Summary, summarize
+from rgbd_eval.metrics import SequenceScores, Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
 from rgbd_eval.report import COLUMNS, format_value, run_notes, table_header, table_rows
 from rgbd_eval.report_html import plots
@@ -27,11 +27,13 @@ from rgbd_eval.report_html.events import frame_errors, markers, worst_frames
 from rgbd_eval.report_html.overlay import rgb_frames
 from rgbd_eval.report_html.render import data_uri, jpeg_uri, render
 from rgbd_eval.report_html.video import Progress, overlay, write_overlay_video
+from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
     from rgbd_eval.compare import Comparison
     from rgbd_eval.plugins import ReproduceResult
+    from rgbd_eval.scoring import ScoredSequence
     from rgbd_eval.sweep import Point, SweepResult
 
 #: Frames in the worst-frame strip of each sequence.
@@ -53,11 +55,27 @@ class Shot:
 
 
 @dataclass(frozen=True)
+class SequenceView:
+    """What the pictures of one sequence need, from a run or from ``score``."""
+
+    name: str
+    world_frame: str
+    ground_truth: Sequence[Sequence[GroundTruthObject]] | None
+    tracks: Sequence[Sequence[TrackOutput]]
+    scores: SequenceScores | None
+
+    @staticmethod
+    def of_run(r: SequenceResult) -> SequenceView:
+        gt = r.ground_truth.frames if r.ground_truth is not None else None
+        return SequenceView(r.name, r.info.world_frame, gt, r.tracks, r.scores)
+
+
+@dataclass(frozen=True)
 class SequenceSection:
     """Everything the page shows of one sequence."""
 
     name: str
-    birds_eye: str
+    birds_eye: str | None
     timeline: str | None
     shots: tuple[Shot, ...]
     error_frames: int
@@ -81,25 +99,23 @@ def config_diff(config: RunConfig) -> list[tuple[str, Any, Any]]:
 
 def _section(
     folder: Path,
-    r: SequenceResult,
+    view: SequenceView,
     images: Mapping[int, NDArray[np.uint8]],
     worst: Sequence[int],
     video: str | None,
+    birds_eye: bool = True,
 ) -> SequenceSection:
-    """The section of one sequence; also writes its ``<name>.birdseye.png`` into ``folder``."""
-    marks = markers(r.scores.frames) if r.scores is not None else []
-    png = plots.birds_eye(
-        r.name,
-        r.info.world_frame,
-        r.ground_truth.frames if r.ground_truth is not None else None,
-        r.tracks,
-        marks,
-    )
-    (folder / f"{r.name}.birdseye.png").write_bytes(png)
-    birds_eye = data_uri(png)
-    if r.scores is None:
-        return SequenceSection(r.name, birds_eye, None, (), 0, video)
-    errors = frame_errors(r.scores.frames)
+    """The section of one sequence; with ``birds_eye`` also writes ``<name>.birdseye.png``."""
+    scores = view.scores
+    marks = markers(scores.frames, scores.counts.convention) if scores is not None else []
+    uri = None
+    if birds_eye:
+        png = plots.birds_eye(view.name, view.world_frame, view.ground_truth, view.tracks, marks)
+        (folder / f"{view.name}.birdseye.png").write_bytes(png)
+        uri = data_uri(png)
+    if view.scores is None:
+        return SequenceSection(view.name, uri, None, (), 0, video)
+    errors = frame_errors(view.scores.frames)
     shots = []
     for i in worst:
         if i in images:
@@ -107,8 +123,8 @@ def _section(
             caption = f"frame {i}: {e.fp} FP, {e.fn} FN, {e.id_switches} ID switch(es)"
             shots.append(Shot(i, jpeg_uri(images[i]), caption))
     return SequenceSection(
-        r.name,
-        birds_eye,
+        view.name,
+        uri,
         data_uri(plots.timeline(errors, worst)),
         tuple(shots),
         sum(e.total > 0 for e in errors),
@@ -128,6 +144,7 @@ def run_page(
     return render(
         "run.html.j2",
         title=f"rgbd-eval run: {config.method}",
+        kind="run",
         method=config.method,
         evaluation=report["evaluation"],
         diff=config_diff(config),
@@ -169,8 +186,44 @@ def write_run_html(
                 for i, rgb in rgb_frames(Path(r.path), config, worst)
                 if rgb is not None
             }
-        sections.append(_section(folder, r, images, worst, video_name))
+        sections.append(_section(folder, SequenceView.of_run(r), images, worst, video_name))
     write_text(folder / "report.html", run_page(results, config, report, sections))
+
+
+def write_score_html(
+    folder: Path,
+    sequences: Sequence[ScoredSequence],
+    report: Mapping[str, Any],
+    gating: Gating,
+) -> None:
+    """Write ``report.html`` of ``rgbd-eval score`` into ``folder``: as a run's, without images.
+
+    There is no recording to draw on; the bird's-eye plot is drawn where the
+    ground truth has world positions.
+    """
+    from rgbd_eval.scoring import table_rows as score_rows
+
+    sections = []
+    for s in sequences:
+        view = SequenceView(s.name, "world", s.aligned.gt, s.aligned.tracks, s.scores)
+        has_world = any(o.world_xyz is not None for frame in s.aligned.gt for o in frame)
+        sections.append(_section(folder, view, {}, [], None, birds_eye=has_world))
+    page = render(
+        "run.html.j2",
+        title="rgbd-eval score",
+        kind="score",
+        method=str(report["method"]),
+        evaluation=report["evaluation"],
+        diff=None,
+        sequences=report["sequences"],
+        tool=report["tool"],
+        libraries=report["libraries"],
+        header=table_header(),
+        rows=score_rows(sequences, gating),
+        notes=[f"{s.name}: warning: {w}" for s in sequences for w in s.warnings],
+        sections=sections,
+    )
+    write_text(folder / "report.html", page)
 
 
 # ----------------------------------------------------------------------------- sweep
