@@ -162,6 +162,7 @@ def indicator_curves(
     ax.set_ylabel("%")
     ax2.set_ylabel("ID switches")
     ax2.set_ylim(bottom=0)
+    ax2.yaxis.get_major_locator().set_params(integer=True)
     if labels is not None:
         ax.set_xticks(xs, labels)
     h1, l1 = ax.get_legend_handles_labels()
