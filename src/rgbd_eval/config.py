@@ -10,6 +10,7 @@ parameters of the reference system (seed 000, Tables 5.1 and 6.1); the files in
 from __future__ import annotations
 
 import enum
+import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,9 @@ from rgbd_eval.errors import ConfigError
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, validate_default=True, allow_inf_nan=False
+    )
 
 
 class IoConfig(_Model):
@@ -149,6 +152,20 @@ class DetectorConfig(_Model):
             )
         if self.ground_mode is GroundMode.PLANE and self.ground_plane is None:
             raise ValueError("ground_mode 'plane' needs ground_plane: [a, b, c, d]")
+        if self.ground_plane is not None and math.hypot(*self.ground_plane[:3]) < 1e-12:
+            raise ValueError(f"ground_plane={list(self.ground_plane)}: normal (a, b, c) is zero")
+        if self.ground_points is not None and len(self.ground_points) == 3:
+            (ax, ay, az), (bx, by, bz), (cx, cy, cz) = self.ground_points
+            u, v = (bx - ax, by - ay, bz - az), (cx - ax, cy - ay, cz - az)
+            normal = (
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            )
+            if math.hypot(*normal) < 1e-9:  # as detect.plane.plane_from_points
+                raise ValueError(f"ground_points={self.ground_points}: collinear or coincide")
+        if self.ground_pixels is not None and any(u < 0 or v < 0 for u, v in self.ground_pixels):
+            raise ValueError(f"ground_pixels={self.ground_pixels}: pixel coordinates must be >= 0")
         return self
 
 
@@ -157,6 +174,10 @@ class ClusterSelection(enum.Enum):
 
     HEIGHT = "height"
     CONFIDENCE = "confidence"
+
+
+#: Longest track-management duration accepted (about 11.6 days): beyond it stamps overflow.
+MAX_DURATION_S = 1e6
 
 
 class TrackerConfig(_Model):
@@ -223,6 +244,19 @@ class TrackerConfig(_Model):
             raise ValueError(
                 f"selectors={self.selectors} must not exceed weak_classifiers={self.weak_classifiers}"
             )
+        durations = {}
+        for name in ("frames_before_old", "frames_before_fake", "frames_remain_new"):
+            try:
+                durations[name] = self.seconds(getattr(self, name))
+            except OverflowError:  # a frame count beyond float range
+                durations[name] = math.inf
+        durations["classifier_memory_s"] = self.classifier_memory_s or 0.0
+        for name, seconds in durations.items():
+            if not seconds <= MAX_DURATION_S:  # also catches inf from a tiny reference_rate_hz
+                raise ValueError(
+                    f"{name} lasts {seconds:g} s at reference_rate_hz={self.reference_rate_hz:g}, "
+                    f"more than {MAX_DURATION_S:g} s"
+                )
         return self
 
     def seconds(self, frames: int) -> float:
@@ -276,17 +310,26 @@ class RunConfig(_Model):
 # ----------------------------------------------------------------------------- loading
 
 
-def format_validation_error(err: ValidationError, source: str) -> str:
+def format_validation_error(
+    err: ValidationError, source: str, overridden: Iterable[str] = ()
+) -> str:
+    """One line per problem, joined; a problem under a ``--set`` key is blamed on that override."""
+    keys = tuple(overridden)
     parts = []
+    from_file = False
     for e in err.errors():
         loc = ".".join(str(p) for p in e["loc"])
+        # An override inside the failing section (a cross-field check) is the likely cause.
+        from_file |= not any(
+            loc == k or loc.startswith(f"{k}.") or k.startswith(f"{loc}.") for k in keys
+        )
         msg = e["msg"]
         if e["type"] == "extra_forbidden":
             msg = "unknown key"
         value = e.get("input")
-        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r})"
+        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r:.80})"
         parts.append(f"{loc or '<root>'}: {msg}{shown}")
-    return f"{source}: " + "; ".join(parts)
+    return f"{source if from_file else '--set'}: " + "; ".join(parts)
 
 
 def _parse_value(text: str) -> Any:
@@ -351,12 +394,14 @@ def build_config(
 ) -> RunConfig:
     """Validate a config mapping with overrides applied on top."""
     merged: dict[str, Any] = _deep_copy(dict(data or {}))
+    keys = []
     for key, value in overrides:
         set_dotted(merged, key, value)
+        keys.append(key)
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as err:
-        raise ConfigError(format_validation_error(err, source)) from err
+        raise ConfigError(format_validation_error(err, source, keys)) from err
 
 
 def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:
@@ -365,14 +410,12 @@ def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:
 
 def load_yaml(path: Path) -> dict[str, Any]:
     """Read a YAML mapping, as a :class:`ConfigError` on any failure."""
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as err:
-        raise ConfigError(f"{path}: cannot read config ({err.strerror})") from err
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        raise ConfigError(f"{path}: not valid YAML ({err})") from err
+    from rgbd_eval.files import parse_yaml, read_text
+
+    def error(message: str) -> ConfigError:
+        return ConfigError(f"{path}: {message}")
+
+    data = parse_yaml(read_text(Path(path), error), error)
     if data is None:
         return {}
     if not isinstance(data, dict):

@@ -19,6 +19,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import RunConfig, load_config, repo_root
 from rgbd_eval.errors import InputError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.pipeline import SequenceResult
@@ -114,10 +115,14 @@ def run(
     json_out: Annotated[
         bool, typer.Option("--json", help="print report.json on stdout instead of a table")
     ] = False,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
-    from rgbd_eval.report import write_run
+    from rgbd_eval.report import REPORT_FILE, write_run
 
     sets = list(overrides or [])
     if gating is not None:
@@ -135,12 +140,12 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with progress_bar() as bar:
-        for path in recordings:
+    with OutputFolder(out_dir, REPORT_FILE, force) as folder, progress_bar() as bar:
+        for path in recordings:  # the output folder is checked and staged before this work
             task = bar.add_task(path.name, total=None)
             results.append(run_sequence(path, config, gt, advance_callback(bar, task)))
             bar.remove_task(task)
-    report = write_run(out_dir, results, config)
+        report = write_run(folder, results, config)
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -14,6 +15,7 @@ from rich.table import Table
 from rgbd_eval.cli.common import SCHEMA_VERSION, console, handle_errors
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.sweep import SweepResult
@@ -62,6 +64,39 @@ def _csv(rows: list[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
+def _write_outputs(
+    folder: OutputFolder,
+    result: SweepResult,
+    wall: float,
+    method: str,
+    recordings: list[Path],
+    fixed: list[str],
+) -> None:
+    """``sweep.csv``, ``sweep.png`` and ``sweep.json`` into the staging folder, then publish."""
+    tmp = folder.staging
+    rows = result.rows()
+    (tmp / "sweep.csv").write_text(_csv(rows), encoding="utf-8")
+    if len(result.params) == 1:
+        sweep_plot(result, tmp / "sweep.png")
+    record = {
+        "schema_version": SCHEMA_VERSION,
+        "params": list(result.params),
+        "method": method,
+        "datasets": [str(p) for p in recordings],
+        "fixed": fixed,
+        "records": rows,
+        "seconds": {
+            "wall": wall,
+            "detect": result.detect_seconds,
+            "track_score": result.track_seconds,
+        },
+        "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
+    }
+    text = json.dumps(record, indent=2, allow_nan=False) + "\n"
+    (tmp / "sweep.json").write_text(text, encoding="utf-8")
+    folder.commit()
+
+
 @handle_errors
 def sweep(
     param: Annotated[
@@ -89,10 +124,13 @@ def sweep(
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
-    from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.config import load_config
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
@@ -139,31 +177,12 @@ def sweep(
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
     jobs = jobs if jobs is not None else default_jobs()
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
-    start = time.perf_counter()
-    result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
-    wall = time.perf_counter() - start
-    rows = result.rows()
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_text(out_dir / "sweep.csv", _csv(rows))
-    write_json(
-        out_dir / "sweep.json",
-        {
-            "schema_version": SCHEMA_VERSION,
-            "params": list(result.params),
-            "method": method,
-            "datasets": [str(p) for p in recordings],
-            "fixed": fixed,
-            "records": rows,
-            "seconds": {
-                "wall": wall,
-                "detect": result.detect_seconds,
-                "track_score": result.track_seconds,
-            },
-            "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
-        },
-    )
-    if len(result.params) == 1:
-        sweep_plot(result, out_dir / "sweep.png")
+    folder = OutputFolder(out_dir, "sweep.json", force)
+    with folder:  # checked and staged before the sweep; published whole or not at all
+        start = time.perf_counter()
+        result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
+        wall = time.perf_counter() - start
+        _write_outputs(folder, result, wall, method, recordings, fixed)
     g = configs[0].evaluation.gating if configs else Gating.IOU
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
