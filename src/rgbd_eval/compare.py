@@ -88,7 +88,7 @@ def load_report(path: Path) -> dict[str, Any]:
     def error(message: str) -> CompareInputError:
         return CompareInputError(f"{path}: {message}")
 
-    text = read_text(path, error)
+    text = read_text(path, error, "report")
     try:
         data = json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as err:

@@ -311,9 +311,16 @@ class RunConfig(_Model):
 
 
 def format_validation_error(
-    err: ValidationError, source: str, overridden: Iterable[str] = ()
+    err: ValidationError,
+    source: str,
+    overridden: Iterable[str] = (),
+    override_source: str | None = None,
 ) -> str:
-    """One line per problem, joined; a problem under a ``--set`` key is blamed on that override."""
+    """Problems joined on one line, prefixed by ``source``.
+
+    When every problem lies under an ``overridden`` key and ``override_source`` is
+    given (``--set``), that is the prefix: the file is not to blame.
+    """
     keys = tuple(overridden)
     parts = []
     from_file = False
@@ -329,7 +336,8 @@ def format_validation_error(
         value = e.get("input")
         shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r:.80})"
         parts.append(f"{loc or '<root>'}: {msg}{shown}")
-    return f"{source if from_file else '--set'}: " + "; ".join(parts)
+    prefix = source if from_file or override_source is None else override_source
+    return f"{prefix}: " + "; ".join(parts)
 
 
 def _parse_value(text: str) -> Any:
@@ -391,8 +399,9 @@ def build_config(
     data: Mapping[str, Any] | None = None,
     overrides: Iterable[tuple[str, Any]] = (),
     source: str = "config",
+    override_source: str | None = None,
 ) -> RunConfig:
-    """Validate a config mapping with overrides applied on top."""
+    """Validate a config mapping with overrides applied on top (see format_validation_error)."""
     merged: dict[str, Any] = _deep_copy(dict(data or {}))
     keys = []
     for key, value in overrides:
@@ -401,7 +410,7 @@ def build_config(
     try:
         return RunConfig.model_validate(merged)
     except ValidationError as err:
-        raise ConfigError(format_validation_error(err, source, keys)) from err
+        raise ConfigError(format_validation_error(err, source, keys, override_source)) from err
 
 
 def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:
@@ -415,7 +424,7 @@ def load_yaml(path: Path) -> dict[str, Any]:
     def error(message: str) -> ConfigError:
         return ConfigError(f"{path}: {message}")
 
-    data = parse_yaml(read_text(Path(path), error), error)
+    data = parse_yaml(read_text(Path(path), error, "config"), error)
     if data is None:
         return {}
     if not isinstance(data, dict):
@@ -438,7 +447,7 @@ def load_config(
         source = str(path)
     if method is not None:
         data["method"] = method
-    return build_config(data, parse_overrides(overrides), source)
+    return build_config(data, parse_overrides(overrides), source, "--set")
 
 
 def config_to_dict(config: RunConfig) -> dict[str, Any]:

@@ -38,52 +38,59 @@ def _kind(mode: int) -> str:
     return "not a regular file"
 
 
-def check_input(path: Path, error: ErrorFactory, allow_dir: bool = False) -> os.stat_result:
-    """``stat`` of ``path`` (links followed); the caller's error unless a regular file (or folder)."""
+def check_input(
+    path: Path, error: ErrorFactory, what: str = "file", allow_dir: bool = False
+) -> os.stat_result:
+    """``stat`` of ``path`` (links followed); the caller's error unless a regular file (or folder).
+
+    ``what`` names the input in messages ("cannot read config (...)").
+    """
     try:
         st = os.stat(path)
-    except FileNotFoundError as err:
-        raise error("no such file or folder") from err
     except OSError as err:
-        raise error(f"cannot read ({err.strerror})") from err
+        raise error(f"cannot read {what} ({err.strerror})") from err
     if stat.S_ISDIR(st.st_mode):
         if allow_dir:
             return st
-        raise error("is a folder, expected a file")
+        raise error(f"cannot read {what} (it is a folder)")
     if not stat.S_ISREG(st.st_mode):
-        raise error(f"is {_kind(st.st_mode)}, expected a regular file")
+        raise error(f"cannot read {what} (it is {_kind(st.st_mode)}, not a regular file)")
     return st
 
 
-def read_bytes(path: Path, error: ErrorFactory, limit: int = MAX_TEXT_BYTES) -> bytes:
+def read_bytes(
+    path: Path, error: ErrorFactory, what: str = "file", limit: int = MAX_TEXT_BYTES
+) -> bytes:
     """The whole content of a regular file no larger than ``limit`` bytes."""
-    st = check_input(path, error)
+    st = check_input(path, error, what)
     if st.st_size > limit:
-        raise error(f"is {st.st_size} bytes, more than the {limit}-byte limit for this input")
+        raise error(f"{what} is {st.st_size} bytes, more than the {limit}-byte limit")
     try:
         with open(path, "rb") as handle:
             data = handle.read(limit + 1)
     except OSError as err:
-        raise error(f"cannot read ({err.strerror})") from err
+        raise error(f"cannot read {what} ({err.strerror})") from err
     if len(data) > limit:  # grew while reading
-        raise error(f"is more than the {limit}-byte limit for this input")
+        raise error(f"{what} is more than the {limit}-byte limit")
     return data
 
 
-def decode_text(data: bytes, error: ErrorFactory) -> str:
+def decode_text(data: bytes, error: ErrorFactory, what: str = "file") -> str:
     """UTF-8 text, a leading byte-order mark skipped; the error names the first bad byte."""
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
         bad = data[err.start : err.start + 1].hex()
         raise error(
-            f"is not UTF-8 text (byte 0x{bad} at offset {err.start}); save it as UTF-8"
+            f"{what} is not UTF-8 text (byte 0x{bad} at offset {err.start}); save it as UTF-8"
         ) from err
 
 
-def read_text(path: Path, error: ErrorFactory, limit: int = MAX_TEXT_BYTES) -> str:
+def read_text(
+    path: Path, error: ErrorFactory, what: str = "file", limit: int = MAX_TEXT_BYTES
+) -> str:
     """A regular, bounded UTF-8 text file (BOM allowed)."""
-    return decode_text(read_bytes(path, error, limit), error)
+    return decode_text(read_bytes(path, error, what, limit), error, what)
 
 
 class _StrictLoader(yaml.SafeLoader):

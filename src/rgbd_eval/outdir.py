@@ -77,6 +77,19 @@ def _read_manifest(folder: Path) -> set[str]:
     return {f for f in files if isinstance(f, str) and "/" not in f and f not in ("", ".", "..")}
 
 
+def check_output_file(path: Path) -> None:
+    """OutputError unless ``path`` can be written as a file (its parent is created)."""
+    path = Path(path)
+    if path.is_dir():
+        raise OutputError(path, "is a folder; name a file (its content would be lost)")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as err:
+        raise OutputError(path, f"cannot create its parent folder ({err.strerror})") from err
+    if not os.access(path.parent, os.W_OK):
+        raise OutputError(path, "its folder is not writable")
+
+
 class OutputFolder:
     """Stage a command's output files and publish them into ``target`` (see the module doc)."""
 

@@ -11,7 +11,7 @@ import typer
 try:  # typer >= 0.22 vendors click; older releases use the click package
     from typer._click import ClickException
 except ImportError:  # pragma: no cover - depends on the installed typer
-    from click import ClickException  # type: ignore[assignment,no-redef]
+    from click import ClickException  # type: ignore[assignment,unused-ignore]
 
 from rgbd_eval import __version__
 from rgbd_eval.cli.bench_cmd import bench

@@ -166,7 +166,7 @@ def _one_box(values: Sequence[float | None], what: str) -> bool:
 def read_csv(path: Path) -> GroundTruth:
     """Read the sidecar CSV; any malformed line is a :class:`GroundTruthError` naming it."""
     path = Path(path)
-    text = read_text(path, lambda m: GroundTruthError(path, m))
+    text = read_text(path, lambda m: GroundTruthError(path, m), "ground truth")
     objects = []
     with io.StringIO(text, newline="") as handle:
         reader = csv.DictReader(handle)
@@ -275,7 +275,7 @@ def _stamp_ns(text: str) -> int:
 def read_ktp(path: Path) -> GroundTruth:
     """Read a KTP ground-truth text file (2D boxes or 3D positions, detected per file)."""
     path = Path(path)
-    lines = read_text(path, lambda m: GroundTruthError(path, m)).splitlines()
+    lines = read_text(path, lambda m: GroundTruthError(path, m), "ground truth").splitlines()
     objects = []
     arity: int | None = None
     frame = -1
@@ -355,7 +355,7 @@ def load_ground_truth(path: Path) -> GroundTruth:
     path = Path(path)
     if not path.exists():
         raise GroundTruthError(path, "ground-truth file not found")
-    check_input(path, lambda m: GroundTruthError(path, m))
+    check_input(path, lambda m: GroundTruthError(path, m), "ground truth")
     if path.suffix.lower() == ".csv":
         return read_csv(path)
     return read_ktp(path)

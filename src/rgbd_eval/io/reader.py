@@ -35,7 +35,8 @@ from rgbd_eval.errors import (
     TopicError,
     TransformError,
 )
-from rgbd_eval.io import groundtruth, images
+from rgbd_eval.files import check_input
+from rgbd_eval.io import groundtruth, images, validate
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -202,6 +203,13 @@ class Recording:
         self._poses = poses
         self._depth_to_rgb = depth_to_rgb
         self.ground_truth_topic = ground_truth
+        self.empty_depth_frames: list[int] = []  # indices, filled while frames() runs
+
+    @property
+    def frame_warnings(self) -> tuple[str, ...]:
+        """Warnings found while decoding (after :meth:`frames` ran): empty depth frames."""
+        warning = validate.empty_depth_warning(self.empty_depth_frames, len(self._pairs))
+        return () if warning is None else (warning,)
 
     def __len__(self) -> int:
         return len(self._pairs)
@@ -219,6 +227,7 @@ class Recording:
         depth_ready: dict[int, NDArray[np.float32]] = {}
         counters = {sel.rgb: 0, sel.depth: 0}
         next_k = 0
+        self.empty_depth_frames = []
         info = self.info
         try:
             with open_source(self.path) as src:
@@ -235,6 +244,8 @@ class Recording:
                         rgb_ready[k] = self._decode(msg, topic, info.rgb_camera, color=True)
                     else:
                         depth_ready[k] = self._decode(msg, topic, info.depth_camera, color=False)
+                        if validate.depth_is_empty(depth_ready[k]):
+                            self.empty_depth_frames.append(k)
                     while next_k in rgb_ready and next_k in depth_ready:
                         yield Frame(
                             index=next_k,
@@ -255,12 +266,16 @@ class Recording:
             raise InputError(
                 self.path, f"recording ended after {next_k} of {len(self._pairs)} indexed frames"
             )
+        if next_k and len(self.empty_depth_frames) == next_k:
+            raise DecodeError(self.path, "no depth frame holds a valid pixel", sel.depth)
 
     def _decode(self, msg: Any, topic: str, camera: CameraModel, color: bool) -> Any:
         try:
             img = images.decode_color(msg) if color else images.decode_depth(msg)
         except images.ImageFormatError as err:
             raise DecodeError(self.path, str(err), topic) from err
+        if (problem := validate.image_size_problem(img)) is not None:
+            raise DecodeError(self.path, problem, topic)
         if img.shape[:2] != (camera.height, camera.width):
             raise DecodeError(
                 self.path,
@@ -317,6 +332,7 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
     io = io or IoConfig()
     if not path.exists():
         raise InputError(path, "no such file or folder")
+    check_input(path, lambda m: InputError(path, m), "recording", allow_dir=True)
     kind = container_kind(path)
     warnings: list[str] = []
     try:
