@@ -11,6 +11,17 @@ import pytest
 
 from rgbd_eval.cli.main import main
 
+#: Generous bound on one in-process command (the slowest case takes a few seconds).
+TIME_LIMIT_S = 120
+
+
+class HungError(Exception):
+    """The command did not finish within TIME_LIMIT_S."""
+
+
+def _hung(signum: int, frame: object) -> None:
+    raise HungError(f"no answer within {TIME_LIMIT_S} s")
+
 
 @dataclass(frozen=True)
 class Outcome:
@@ -29,10 +40,14 @@ def run_cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> Outcome:
     argv = sys.argv
     sys.argv = ["rgbd-eval", *args]
     capsys.readouterr()
+    previous_alarm = signal.signal(signal.SIGALRM, _hung)
+    signal.alarm(TIME_LIMIT_S)  # a hang (e.g. opening a named pipe) fails instead of blocking
     try:
         with pytest.raises(SystemExit) as exited:
             main()
     finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, previous_alarm)
         sys.argv = argv
         for s, h in handlers.items():
             signal.signal(s, h)

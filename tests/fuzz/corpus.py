@@ -10,7 +10,7 @@ from __future__ import annotations
 import json
 import os
 import struct
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -102,9 +102,9 @@ def mcap_chunk_data_offset(path: Path) -> int:
         opcode, length = struct.unpack_from("<BQ", data, pos)
         if opcode == 0x06:  # Chunk: start 8, end 8, uncompressed size 8, crc 4, compression
             body = pos + 9
-            (clen,) = struct.unpack_from("<I", data, body + 28)
+            clen = int(struct.unpack_from("<I", data, body + 28)[0])
             records_at = body + 32 + clen + 8  # after compression string and records length
-            (rlen,) = struct.unpack_from("<Q", data, body + 32 + clen)
+            rlen = int(struct.unpack_from("<Q", data, body + 32 + clen)[0])
             return records_at + rlen // 2
         pos += 9 + length
     raise ValueError("no chunk")
@@ -114,7 +114,7 @@ def mcap_summary_offset(path: Path) -> int:
     """Offset of a byte inside the summary section (from the footer)."""
     data = path.read_bytes()
     footer = len(data) - 8 - 29
-    (summary_start,) = struct.unpack_from("<Q", data, footer + 9)
+    summary_start = int(struct.unpack_from("<Q", data, footer + 9)[0])
     return summary_start + 20
 
 
@@ -365,7 +365,7 @@ def _output_cases() -> list[Case]:
 
 
 def report(
-    metrics: dict[str, object] | None, name: str = "rec", **extra: object
+    metrics: Mapping[str, object] | None, name: str = "rec", **extra: object
 ) -> dict[str, object]:
     """A minimal valid report with one sequence."""
     data: dict[str, object] = {

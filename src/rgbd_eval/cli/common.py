@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import signal
 import sys
 from collections.abc import Callable
 from typing import Any, ParamSpec, TypeVar
@@ -83,6 +84,12 @@ def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
         except RgbdEvalError as err:
             typer.echo(f"error: {one_line(str(err))}", err=True)
             raise typer.Exit(err.exit_code) from None
+        except KeyboardInterrupt:  # outputs were removed on the way out (staged folders)
+            typer.echo("error: interrupted", err=True)
+            raise typer.Exit(128 + signal.SIGINT) from None
+        except Interrupted as err:
+            typer.echo(f"error: interrupted by signal {err.signum}", err=True)
+            raise typer.Exit(128 + err.signum) from None
 
     return wrapper
 
