@@ -444,6 +444,82 @@ def _compare_cases() -> list[Case]:
     ]
 
 
+def _other_command_cases() -> list[Case]:
+    def with_bad_sidecar(root: Path) -> Path:
+        rec = good_recording(root)
+        (root / "rec.gt.csv").write_text(GT_HEADER + "0,0,1,10\n")  # a short row
+        return rec
+
+    def run_sidecar(root: Path) -> list[str]:
+        return ["run", str(with_bad_sidecar(root)), "--out", str(root / "out")]
+
+    def sweep_sidecar(root: Path) -> list[str]:
+        rec = with_bad_sidecar(root)
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            "0",
+            "--dataset",
+            str(rec),
+            "--jobs",
+            "2",
+            "--out",
+            str(root / "out"),
+        ]
+
+    def sweep_corrupt(root: Path) -> list[str]:
+        rec = root / "flip.mcap"
+        write_recording(rec, "mcap", Spec(n=FRAMES))
+        flip_byte(rec, mcap_chunk_data_offset(rec))
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            "0",
+            "--dataset",
+            str(rec),
+            "--jobs",
+            "2",
+            "--out",
+            str(root / "out"),
+        ]
+
+    def sweep_nan(root: Path) -> list[str]:
+        rec = good_recording(root)
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            ".nan",
+            "--dataset",
+            str(rec),
+            "--out",
+            str(root / "out"),
+        ]
+
+    def inspect_bad_gt(root: Path) -> list[str]:
+        (root / "short.csv").write_text(GT_HEADER + "0,0,1,10\n")
+        return ["inspect", str(good_recording(root)), "--gt", str(root / "short.csv")]
+
+    def zero_quat(command: str, *extra: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            rec = odd_recording(root / "zq.bag", odom=_zero_quat)
+            return [command, str(rec), *extra]
+
+        return build
+
+    return [
+        Case("run_sidecar_short_row", "TRACEBACK", run_sidecar, 5, "fewer fields"),
+        Case("sweep_sidecar_short_row", "TRACEBACK", sweep_sidecar, 5, "fewer fields"),
+        Case("sweep_nan_value", "TRACEBACK", sweep_nan, 4, "finite"),
+        Case("sweep_corrupt_in_worker", "SILENT", sweep_corrupt, 3, "crc"),
+        Case("inspect_bad_gt", "TRACEBACK", inspect_bad_gt, 5, "fewer fields"),
+        Case("inspect_json_zero_quat", "TRACEBACK", zero_quat("inspect", "--json"), 3, "norm 0"),
+        Case("bench_zero_quat", "TRACEBACK", zero_quat("bench", "--repeat", "1"), 3, "norm 0"),
+    ]
+
+
 def all_cases() -> list[Case]:
     """Every case of the corpus."""
     return [
@@ -453,6 +529,7 @@ def all_cases() -> list[Case]:
         *_usage_cases(),
         *_output_cases(),
         *_compare_cases(),
+        *_other_command_cases(),
     ]
 
 
