@@ -111,7 +111,10 @@ class AnyReaderSource(MessageSource):
             yield conn.topic, log_ns, raw
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
-        return self._reader.deserialize(bytes(raw), msgtype)
+        try:
+            return self._reader.deserialize(bytes(raw), msgtype)
+        except KeyError as err:  # a damaged type table names a type the typestore lacks
+            raise ValueError(f"message type {msgtype!r} has no definition") from err
 
     def close(self) -> None:
         self._reader.close()
@@ -165,7 +168,10 @@ class McapSource(MessageSource):
             yield channel.topic, message.log_time, message.data
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
-        return self.store.deserialize_cdr(raw, msgtype)
+        try:
+            return self.store.deserialize_cdr(raw, msgtype)
+        except KeyError as err:
+            raise ValueError(f"message type {msgtype!r} has no definition") from err
 
     def close(self) -> None:
         self._handle.close()
