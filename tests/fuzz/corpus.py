@@ -118,6 +118,33 @@ def mcap_summary_offset(path: Path) -> int:
     return summary_start + 20
 
 
+def without_statistics(source: Path, target: Path) -> Path:
+    """``source`` rewritten with the same records but no Statistics record in its summary."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+
+    with source.open("rb") as fin, target.open("wb") as fout:
+        reader = make_reader(fin)
+        writer = Writer(fout, compression=CompressionType.ZSTD, use_statistics=False)
+        writer.start(profile="ros2", library="test")
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for schema, channel, message in reader.iter_messages():
+            if schema is not None and schema.id not in schemas:
+                schemas[schema.id] = writer.register_schema(
+                    schema.name, schema.encoding, schema.data
+                )
+            if channel.id not in channels:
+                channels[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, schemas.get(channel.schema_id, 0)
+                )
+            writer.add_message(
+                channels[channel.id], message.log_time, message.data, message.publish_time
+            )
+        writer.finish()
+    return target
+
+
 def _nan_quat(stamp: int) -> Pose:
     p = odom_pose(stamp)
     return Pose(p.translation, (0.0, 0.0, float("nan"), 1.0)) if stamp > T0 else p

@@ -15,7 +15,14 @@ import pytest
 
 from rgbd_eval.io.groundtruth import write_csv
 from tests.fuzz.cli import leftovers, run_cli
-from tests.fuzz.corpus import FRAMES, flip_byte, good_recording, ground_truth_objects, odd_recording
+from tests.fuzz.corpus import (
+    FRAMES,
+    flip_byte,
+    good_recording,
+    ground_truth_objects,
+    odd_recording,
+    without_statistics,
+)
 from tests.io.conftest import depth_image
 
 
@@ -127,3 +134,14 @@ def test_sigterm_during_run_cleans_up(tmp_path: Path) -> None:
     assert proc.returncode == 128 + signal.SIGTERM, stderr
     assert stderr.strip().splitlines()[-1] == f"error: interrupted by signal {int(signal.SIGTERM)}"
     assert leftovers(tmp_path) == [] and not out.exists()
+
+
+def test_mcap_without_statistics_is_read_not_called_empty(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = without_statistics(good_recording(tmp_path), tmp_path / "nostats.mcap")
+    out = tmp_path / "out"
+    result = run_cli(["run", str(rec), "--out", str(out)], capsys)
+    assert result.code == 0, result.stderr  # was exit 3, "recording is empty (no messages)"
+    report = json.loads((out / "report.json").read_text())
+    assert report["sequences"][0]["frames"] == FRAMES and report["sequences"][0]["scored"]
