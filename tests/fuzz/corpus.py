@@ -248,7 +248,13 @@ def _gt_case(name: str, text: bytes, code: int, message: str, suffix: str = ".cs
 def _gt_cases() -> list[Case]:
     row = "0,0,1,10,5,8,30,2.0,0.1,0.9,1\n"
     stamp = T0 / 1e9
+
+    def fifo(root: Path) -> list[str]:
+        os.mkfifo(root / "pipe.csv")
+        return ["run", str(good_recording(root)), "--gt", str(root / "pipe.csv")]
+
     return [
+        Case("gt_fifo", "HANG", fifo, 5, "named pipe"),
         _gt_case("short_row", (GT_HEADER + "0,0,1,10\n").encode(), 5, "fewer fields"),
         _gt_case("long_row", (GT_HEADER + row.strip() + ",1,2,3\n").encode(), 5, "more fields"),
         _gt_case("latin1", (GT_HEADER + "# caf\xe9\n").encode("latin-1"), 5, "not UTF-8"),
