@@ -289,8 +289,8 @@ def _acos_table() -> Float32Array:
 def _histogram_loop(
     img: Float32Array,
     table: Float32Array,
-    rsqrt: Float32Array,
-    rcp: Float32Array,
+    rsqrt: NDArray[np.uint32],
+    rcp: NDArray[np.uint32],
     approximate: bool,
     hist: Float32Array,
 ) -> None:
@@ -383,21 +383,21 @@ def _histogram_loop(
             w01 = yd - xyd  # (xb0, yb0 + 1)
             w10 = xd - xyd  # (xb0 + 1, yb0)
             w11 = xyd  # (xb0 + 1, yb0 + 1)
-            for b, mb in ((bin0, m0), (bin1, m1)):
+            for ob, mb in ((bin0, m0), (bin1, m1)):
                 if has_lf:
                     if yb0 >= 0:
-                        hist[b, xb0, yb0] += w00 * mb
+                        hist[ob, xb0, yb0] += w00 * mb
                     if yb0 + 1 < hb:
-                        hist[b, xb0, yb0 + 1] += w01 * mb
+                        hist[ob, xb0, yb0 + 1] += w01 * mb
                 if has_rt:
                     if yb0 >= 0:
-                        hist[b, xb0 + 1, yb0] += w10 * mb
+                        hist[ob, xb0 + 1, yb0] += w10 * mb
                     if yb0 + 1 < hb:
-                        hist[b, xb0 + 1, yb0 + 1] += w11 * mb
+                        hist[ob, xb0 + 1, yb0 + 1] += w11 * mb
 
 
 _histogram_kernel: Callable[
-    [Float32Array, Float32Array, Float32Array, Float32Array, bool, Float32Array], None
+    [Float32Array, Float32Array, NDArray[np.uint32], NDArray[np.uint32], bool, Float32Array], None
 ] = numba.njit(cache=True)(_histogram_loop)
 
 
