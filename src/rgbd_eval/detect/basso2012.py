@@ -49,6 +49,7 @@ from rgbd_eval.detect.features import (
     full_body_box,
     occluded_by_nearer_points,
     project_to_rgb,
+    touches_border,
 )
 from rgbd_eval.detect.ground import GroundPlaneEstimator
 from rgbd_eval.detect.hog import hog_confidences
@@ -283,7 +284,7 @@ class Basso2012Detector:
             box = full_body_box(g, np.take(uv, mine, axis=0), project)
             if box is None:
                 continue
-            cut_top, cut_bottom, cut_side = _touches_border(
+            cut_top, cut_bottom, cut_side = touches_border(
                 cloud.pixels[members(c)], frame.depth_camera
             )
             in_view = box_inside_image(box, frame.rgb_camera) and not (
@@ -348,18 +349,6 @@ class Basso2012Detector:
 def _footprint(frame: Frame) -> int:
     """RGB pixels per depth pixel (per side), at least 1."""
     return max(1, round(frame.rgb_camera.fx / frame.depth_camera.fx))
-
-
-def _touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
-    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
-    if pixels.shape[0] == 0:
-        return (False, False, False)
-    rows, cols = np.divmod(pixels, camera.width)
-    return (
-        bool(rows.min() == 0),
-        bool(rows.max() == camera.height - 1),
-        bool(cols.min() == 0 or cols.max() == camera.width - 1),
-    )
 
 
 def _world_box(frame: Frame, points: FloatArray) -> Box3D:
