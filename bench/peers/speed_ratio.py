@@ -29,8 +29,9 @@ import numpy as np
 from tests.detect.scenes import Person, Scene, camera_pose, render
 
 from rgbd_eval.bench import one_core
-from rgbd_eval.config import DetectorConfig, GroundMode
 from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
+from rgbd_eval.detect.basso2012_config import GroundMode
 from rgbd_eval.types import Frame, Pose
 
 MODEL = Path("src/rgbd_eval/data/pcl_people/trainedLinearSVMForPeopleDetectionWithHOG.yaml")
