@@ -57,6 +57,13 @@ def baseline_from_projection(P: NDArray[np.floating]) -> float:
     return baseline
 
 
+def baseline_of(right: CameraModel) -> float:
+    """Baseline B (m) of a rectified pair from its right camera (``tx = -fx B``)."""
+    P = np.zeros((3, 4))
+    P[0, 0], P[0, 3] = right.fx, right.tx
+    return baseline_from_projection(P)
+
+
 def make_matcher(params: SgbmParams) -> cv2.StereoSGBM:
     """A configured ``cv2.StereoSGBM`` for grey images."""
     b = params.block_size
