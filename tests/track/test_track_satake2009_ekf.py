@@ -131,3 +131,16 @@ def test_bad_kinematics_raise() -> None:
         ekf.robot_motion(0.1, 0.2, 0.0, 0.1)
     with pytest.raises(ValueError, match=r"dt=-0\.1"):
         ekf.robot_motion(0.1, 0.2, 0.2, -0.1)
+
+
+@pytest.mark.parametrize("v_L,v_R", [(0.3, 0.5), (-0.2, 0.4), (0.4, 0.4)])
+def test_motion_from_odometry_poses_equals_the_wheel_motion(v_L: float, v_R: float) -> None:
+    # The robot at (1, 2) heading 30 deg drives an arc for 0.5 s; its end pose (closed form)
+    # gives back the wheel-speed motion of 2.3.1.
+    d, dt, yaw = 0.2, 0.5, math.radians(30)
+    m = ekf.robot_motion(v_L, v_R, d, dt)
+    c, s = math.cos(yaw), math.sin(yaw)
+    after = (1 + c * m.d_X - s * m.d_Y, 2 + s * m.d_X + c * m.d_Y, yaw + m.d_theta)
+    got = ekf.motion_from_poses((1.0, 2.0, yaw), after, dt)
+    for name in ("v", "omega", "d_theta", "d_L", "d_X", "d_Y"):
+        assert getattr(got, name) == pytest.approx(getattr(m, name), abs=1e-12), name

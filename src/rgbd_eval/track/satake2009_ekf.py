@@ -17,6 +17,7 @@ does not depend on x).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal
 
@@ -132,3 +133,26 @@ def update(x: Array, P: Array, y: Array, sigma_v: float) -> tuple[Array, Array]:
 def innovation_covariance(P: Array, sigma_v: float) -> Array:
     """``S = H P H^T + R``: the gate of an association (Mahalanobis distance)."""
     return H @ P @ H.T + (sigma_v * sigma_v) * np.eye(3)
+
+
+def motion_from_poses(
+    before: tuple[float, float, float], after: tuple[float, float, float], dt: float
+) -> RobotMotion:
+    """The motion between two planar robot poses ``(x, y, yaw)`` (from odometry) over ``dt``.
+
+    ``d_X, d_Y`` are the displacement seen from ``before``; ``v`` and ``omega`` are those of
+    the circular arc through both poses (2.3.1 inverted: ``d_L = 2 rho sin(d_theta/2)``), so
+    odometry gives the same ``u`` the wheel speeds would.
+    """
+    if not dt > 0:
+        raise ValueError(f"time step dt={dt} must be > 0")
+    x0, y0, a0 = before
+    c, s = math.cos(a0), math.sin(a0)
+    dx, dy = after[0] - x0, after[1] - y0
+    d_X, d_Y = c * dx + s * dy, -s * dx + c * dy
+    d_theta = math.remainder(after[2] - a0, math.tau)
+    d_L = math.hypot(d_X, d_Y) * (1.0 if d_X >= 0 else -1.0)
+    sinc = float(np.sinc(d_theta / (2.0 * np.pi)))
+    return RobotMotion(
+        v=d_L / (dt * sinc), omega=d_theta / dt, d_theta=d_theta, d_L=d_L, d_X=d_X, d_Y=d_Y
+    )
