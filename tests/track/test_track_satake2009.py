@@ -57,8 +57,10 @@ def test_a_static_person_stays_put_while_the_robot_drives_and_turns() -> None:
 
 def test_an_unseen_track_is_kept_for_max_missed_s_then_dropped() -> None:
     # 20 fps, max_missed_s = 0.5: seen at frames 0-2, kept (occluded) through frame 12
-    # (0.5 s after frame 2), gone at frame 13.
-    trk = Satake2009Tracker(Satake2009TrackerConfig(max_missed_s=0.5), DetectionContract())
+    # (0.5 s after frame 2), gone at frame 13. With coast_min_hits = 4 it would not be
+    # output at all once unseen (3 matches).
+    cfg = Satake2009TrackerConfig(max_missed_s=0.5, coast_min_hits=3)
+    trk = Satake2009Tracker(cfg, DetectionContract())
     det = [Detection((3.0, 0.0, 1.7), 1.7, 1.0, Box2D(0, 0, 1, 1))]
     for k in range(3):
         trk.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
@@ -66,6 +68,26 @@ def test_an_unseen_track_is_kept_for_max_missed_s_then_dropped() -> None:
         out = trk.update(k * 50_000_000, [], _frame(k, 0.0, 0.0, 0.0))
         assert [(o.track_id, o.visibility.name) for o in out] == [(1, "OCCLUDED")]
     assert trk.update(13 * 50_000_000, [], _frame(13, 0.0, 0.0, 0.0)) == []
+    strict = Satake2009Tracker(cfg.model_copy(update={"coast_min_hits": 4}), DetectionContract())
+    for k in range(3):
+        strict.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
+    assert strict.update(3 * 50_000_000, [], _frame(3, 0.0, 0.0, 0.0)) == []
+    assert len(strict.tracks) == 1  # still kept, only not output
+
+
+def test_a_second_match_on_the_same_body_starts_no_track() -> None:
+    # Two detections 0.3 m apart (< min_separation_m = 0.5): the first starts track 1; the
+    # second, unmatched, is within 0.5 m of it and starts nothing. At 0.8 m it would.
+    box = Box2D(0, 0, 1, 1)
+    for gap, n_tracks in ((0.3, 1), (0.8, 2)):
+        trk = Satake2009Tracker(Satake2009TrackerConfig(), DetectionContract())
+        trk.update(0, [Detection((3.0, 0.0, 1.7), 1.7, 1.0, box)], _frame(0, 0.0, 0.0, 0.0))
+        dets = [
+            Detection((3.0, 0.0, 1.7), 1.7, 1.0, box),
+            Detection((3.0, gap, 1.7), 1.7, 1.0, box),
+        ]
+        trk.update(50_000_000, dets, _frame(1, 0.0, 0.0, 0.0))
+        assert len(trk.tracks) == n_tracks
 
 
 def test_distance_grid() -> None:

@@ -38,6 +38,10 @@ class Satake2009TrackerConfig(ComponentConfig):
     gate_probability: float = Field(0.99, gt=0.0, lt=1.0, description="chi^2 gate, 3 dof")
     max_missed_s: float = Field(1.0, ge=0.0, description="a track unseen this long is dropped")
     min_hits: int = Field(2, ge=1, description="matches before a track is output")
+    coast_min_hits: int = Field(10, ge=1, description="matches before an unseen track is output")
+    min_separation_m: float = Field(
+        0.5, ge=0.0, description="no new track this near (ground) to an existing one"
+    )
 
 
 def planar_pose(pose: Pose) -> tuple[float, float, float]:
@@ -121,7 +125,9 @@ class Satake2009Tracker:
         keep_ns = cfg.max_missed_s * 1e9
         self.tracks = [t for t in self.tracks if stamp_ns - t.last_seen_ns <= keep_ns]
         for j, y in enumerate(ys):
-            if j in matched:
+            if j in matched or any(
+                math.hypot(*(t.x[:2] - y[:2])) < cfg.min_separation_m for t in self.tracks
+            ):
                 continue
             P = np.diag([cfg.sigma_v**2] * 3 + [cfg.initial_speed_std**2] * 2)
             self.tracks.append(
@@ -130,10 +136,11 @@ class Satake2009Tracker:
             self.next_id += 1
         out = []
         for t in self.tracks:
-            if t.hits < cfg.min_hits:
+            visible = t.last_seen_ns == stamp_ns
+            if t.hits < (cfg.min_hits if visible else cfg.coast_min_hits):
                 continue
             wx, wy = to_world(robot, t.x)
-            vis = Visibility.VISIBLE if t.last_seen_ns == stamp_ns else Visibility.OCCLUDED
+            vis = Visibility.VISIBLE if visible else Visibility.OCCLUDED
             out.append(
                 TrackOutput(t.track_id, wx, wy, float(t.x[2]), t.box, vis, TrackStatus.VALIDATED)
             )
