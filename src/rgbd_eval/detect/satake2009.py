@@ -37,7 +37,9 @@ class Satake2009DetectorConfig(ComponentConfig):
     height: int = Field(384, ge=32, le=4096, description="processed height (seed 4: 384)")
     num_disparities: int = Field(64, ge=16, le=512, description="SGBM disparity range (px)")
     block_size: int = Field(5, ge=1, le=21, description="SGBM block size (odd)")
-    search_scale: float = Field(0.5, gt=0.0, le=1.0, description="image scale of the search")
+    template_rows: int = Field(
+        24, ge=8, le=512, description="search at the image step where a template is this tall"
+    )
     min_distance_m: float = Field(1.0, gt=0.2, description="nearest searched distance")
     max_distance_m: float = Field(6.0, gt=0.5, le=20.0, description="farthest searched distance")
     distance_ratio: float = Field(1.15, gt=1.0, le=2.0, description="step of the distance grid")
@@ -85,19 +87,19 @@ class Satake2009Detector:
     def candidates(self, depth: np.ndarray, fx: float) -> list[st.Match]:
         """Matches above ``min_score`` at every searched distance, best first, suppressed."""
         c = self.cfg
-        s = c.search_scale
-        small = depth
-        if s < 1.0:
-            small = depth[:: round(1 / s), :: round(1 / s)]
-            s = 1.0 / round(1 / s)
         found: list[st.Match] = []
+        tallest = max(t.mask.shape[0] for t in self.templates)
         for D in self.distances:
+            # every step-th pixel, so that the tallest template is about template_rows tall
+            step = max(1, int(tallest * (fx / st.F_REF) * (st.D_REF / D)) // c.template_rows)
+            small = np.ascontiguousarray(depth[::step, ::step])
+            near, free = st.agreement(small, D, c.band_m, c.gap_m)
             for t0 in self.templates:
-                t = st.scale_template(t0, D, fx * s)
+                t = st.scale_template(t0, D, fx / step)
                 th, tw = t.mask.shape
                 if th > small.shape[0] or tw > small.shape[1] or th < 8:
                     continue
-                scores = st.score_map(small, t, c.band_m, c.gap_m)
+                scores = st.score_agreement(near, free, t)
                 ys, xs = np.nonzero(scores >= c.min_score)
                 if not len(ys):
                     continue
@@ -105,9 +107,9 @@ class Satake2009Detector:
                 for y, x in zip(ys[order], xs[order], strict=True):
                     found.append(
                         st.Match(
-                            (x + t.anchor[0]) / s, (y + t.anchor[1]) / s, D,
+                            (x + t.anchor[0]) * step, (y + t.anchor[1]) * step, D,
                             float(scores[y, x]), t.orientation_deg,
-                            (round(x / s), round(y / s), round(tw / s), round(th / s)),
+                            (int(x) * step, int(y) * step, tw * step, th * step),
                         )
                     )  # fmt: skip
         found.sort(key=lambda m: -m.score)

@@ -145,21 +145,33 @@ class Match:
     box: tuple[int, int, int, int]  # left, top, width, height of the template
 
 
+def agreement(
+    depth: NDArray[np.float32], distance: float, band_m: float, gap_m: float
+) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """Per pixel: is it within ``band_m`` of ``distance`` (body), is it free behind (1/0)."""
+    with np.errstate(invalid="ignore"):
+        near = (np.abs(depth - distance) < band_m).astype(np.float32)
+        free = (~(depth <= distance + gap_m)).astype(np.float32)  # farther, or no depth
+    return near, free
+
+
+def score_agreement(
+    near: NDArray[np.float32], free: NDArray[np.float32], t: DistanceTemplate
+) -> NDArray[np.float32]:
+    """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
+    inner = t.mask.astype(np.float32)
+    a = cv2.matchTemplate(near, inner, cv2.TM_CCORR)
+    b = cv2.matchTemplate(free, 1.0 - inner, cv2.TM_CCORR)
+    out: NDArray[np.float32] = ((a + b) / float(inner.size)).astype(np.float32)
+    return out
+
+
 def score_map(
     depth: NDArray[np.float32], t: DistanceTemplate, band_m: float, gap_m: float
 ) -> NDArray[np.float32]:
     """Evaluation value of scaled template ``t`` with its top-left corner at every pixel."""
-    D = t.distance
-    with np.errstate(invalid="ignore"):
-        near = (np.abs(depth - D) < band_m).astype(np.float32)
-        free = ~(depth <= D + gap_m)  # farther, or no depth (NaN)
-    inner = t.mask.astype(np.float32)
-    outer = 1.0 - inner
-    n = float(inner.size)
-    a = cv2.matchTemplate(near, inner, cv2.TM_CCORR)
-    b = cv2.matchTemplate(free.astype(np.float32), outer, cv2.TM_CCORR)
-    out: NDArray[np.float32] = ((a + b) / n).astype(np.float32)
-    return out
+    near, free = agreement(depth, t.distance, band_m, gap_m)
+    return score_agreement(near, free, t)
 
 
 def best_match(
