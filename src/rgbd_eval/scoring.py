@@ -9,7 +9,7 @@ One sequence is a pair (tracker output, ground truth), read by
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -19,6 +19,7 @@ from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
 from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
+from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.report import (
     COLUMNS,
     MATCHING,
@@ -27,7 +28,6 @@ from rgbd_eval.report import (
     file_digest,
     format_value,
     library_versions,
-    staged_output,
 )
 
 
@@ -143,9 +143,16 @@ def table_rows(sequences: Sequence[ScoredSequence], gating: Gating) -> list[list
 
 
 def write_report(
-    out_dir: Path, sequences: Sequence[ScoredSequence], config: EvaluationConfig, max_gap_ns: int
+    out_dir: Path,
+    sequences: Sequence[ScoredSequence],
+    config: EvaluationConfig,
+    max_gap_ns: int,
+    also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write report.json, report.md and one events.csv per sequence, atomically as a folder."""
+    """Write report.json, report.md and one events.csv per sequence, atomically as a folder.
+
+    ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder.
+    """
     from rgbd_eval.report import table_header
 
     report = report_dict(sequences, config, max_gap_ns)
@@ -163,7 +170,8 @@ def write_report(
         "",
         *(f"- {s.name}: warning: {w}" for s in sequences for w in s.warnings),
     ]
-    with staged_output(out_dir) as tmp:
+    with OutputFolder(out_dir, "report.json") as folder:
+        tmp = folder.staging
         for s in sequences:
             (tmp / f"{s.name}.events.csv").write_text(
                 events_csv(s.scores.frames, s.aligned.stamps_ns, s.aligned.frame_numbers),
@@ -173,4 +181,7 @@ def write_report(
         (tmp / "report.json").write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
+        if also is not None:
+            also(tmp, report)
+        folder.commit()
     return report
