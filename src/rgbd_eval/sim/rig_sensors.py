@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
@@ -50,6 +50,10 @@ class SceneView:
     #: Ray-cast static scene + people from ``pose`` (world_T_optical) through ``camera``.
     render: Callable[[CameraModel, Pose], Hits]
     rng: np.random.Generator
+    #: world_T_base_link of the robot at this instant (robot-mounted sensors render from it).
+    base_pose: Pose = field(default_factory=Pose.identity)
+    #: Lit colour ((H, W, 3) float32, 0..255) of rendered hits, as the Kinect's RGB is shaded.
+    shade: Callable[[Hits], NDArray[np.float32]] | None = None
 
 
 class RigSensor(Protocol):

@@ -285,12 +285,19 @@ class Simulator:
         def render(camera: CameraModel, pose: Pose) -> Hits:
             return self._render(people_mesh, people_scene, camera, pose)
 
+        def lit(hits: Hits) -> NDArray[np.float32]:
+            mesh = concatenate([self.static, people_mesh])
+            return shade(mesh, hits, self.light, self.scenario.room.floor_tile)
+
+        x, y, yaw = self.true_poses[index]
         return SceneView(
             index,
             self.scenario.stamp_ns(index),
             rig.WORLD_FRAME,
             render,
             _rng(self.seed, _STREAM_RIG + stream, index),
+            rig.base_pose(float(x), float(y), float(yaw)),
+            lit,
         )
 
     def frames(self, indices: list[int] | None = None) -> Iterator[SimFrame]:
