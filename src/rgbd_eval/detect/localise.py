@@ -115,10 +115,9 @@ def localise(view: DepthView, boxes: Sequence[Box2D]) -> Localisation:
     out: list[LocalisedBox] = []
     kept: list[int] = []
     for i, box in enumerate(boxes):
-        if projected is not None:
-            values = projected.depths(box)
-        else:
-            values = _box_depths_registered(view, box)
+        values = (
+            projected.depths(box) if projected is not None else _box_depths_registered(view, box)
+        )
         if values.size == 0:
             continue
         z = float(np.percentile(values, DEPTH_PERCENTILE))

@@ -151,9 +151,10 @@ def gallery_distances(descriptors: Array, galleries: Sequence[Array]) -> Array:
 
 def gate_costs(C: Array, S: Array, params: Pinto2022Params) -> Array:
     """Algorithm 1, lines 7-12: the cost matrix with inadmissible pairs at the infinite cost."""
-    ambiguous_and_far = (params.t_lower < C) & (params.t_upper > C) & (params.s_max < S)
-    dissimilar = C >= params.t_upper
-    return np.where(ambiguous_and_far | dissimilar, INFINITE_COST, C)
+    cost, spatial = C, S
+    ambiguous_and_far = (cost > params.t_lower) & (cost < params.t_upper) & (spatial > params.s_max)
+    dissimilar = cost >= params.t_upper
+    return np.where(ambiguous_and_far | dissimilar, INFINITE_COST, cost)
 
 
 def associate(C: Array) -> list[tuple[int, int]]:
