@@ -18,7 +18,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
-from rgbd_eval.config import format_validation_error, load_yaml, repo_root, set_dotted
+from rgbd_eval.config import config_dir, format_validation_error, load_yaml, set_dotted
 from rgbd_eval.errors import ConfigError
 
 Colour = tuple[int, int, int]
@@ -400,7 +400,7 @@ def load_scenario(path: Path | str, overrides: Iterable[tuple[str, Any]] = ()) -
 
 def scenarios_dir() -> Path:
     """``configs/scenarios`` of the source checkout."""
-    return repo_root() / "configs" / "scenarios"
+    return config_dir() / "scenarios"
 
 
 def scenario_paths() -> list[Path]:
