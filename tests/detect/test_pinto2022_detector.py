@@ -30,7 +30,7 @@ def _frame() -> Frame:
     rgb[:, :4] = (200, 30, 30)
     depth = np.full((6, 8), np.nan, dtype=np.float32)
     depth[:, :4] = 2.0  # only the left half has depth
-    return Frame(
+    return Frame.rgbd(
         index=7,
         stamp_ns=123,
         rgb=rgb,

@@ -16,9 +16,28 @@ from __future__ import annotations
 import time
 from collections.abc import Mapping
 
+from rgbd_eval.detect.hog_people import HogParams, HogPeopleDetector
 from rgbd_eval.detect.localise import DepthView, localise
 from rgbd_eval.detect.person2d import ColourImage, PersonDetector2D
-from rgbd_eval.detect.reid import Embedder
+from rgbd_eval.detect.pinto2022_config import (
+    PersonBackend,
+    PersonDetectorConfig,
+    Pinto2022DetectorConfig,
+    ReidBackend,
+    ReidConfig,
+)
+from rgbd_eval.detect.recorded import RecordedDetector, RecordedParams
+from rgbd_eval.detect.reid import (
+    ColourTextureEmbedder,
+    Embedder,
+    OnnxEmbedder,
+    OnnxEmbedderParams,
+    builtin_mobilenet,
+)
+from rgbd_eval.detect.ssdlite import SsdLiteDetector, SsdParams
+from rgbd_eval.detect.yolo_onnx import OnnxYoloDetector, YoloLayout, YoloParams
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Detection, Frame
 
 STAGES = ("person2d", "localise", "embed")
@@ -65,3 +84,78 @@ class Pinto2022Detector:
             )
             for k, (i, lb) in enumerate(zip(located.kept, located.boxes, strict=True))
         ]
+
+
+def build_person_detector(config: PersonDetectorConfig, threads: int = 1) -> PersonDetector2D:
+    """The 2D person detector a config names."""
+    b = config.backend
+    if b is PersonBackend.SSDLITE:
+        return SsdLiteDetector(
+            config.model, SsdParams(config.score_threshold, config.nms_iou, threads)
+        )
+    if b is PersonBackend.ONNX:
+        if config.model is None:  # the config model refuses this; kept for the type checker
+            raise ConfigError("detector.person.model is required for backend 'onnx'")
+        params = YoloParams(
+            config.score_threshold,
+            config.nms_iou,
+            config.person_class,
+            YoloLayout(config.layout),
+            config.input_size,
+            threads,
+        )
+        return OnnxYoloDetector(config.model, params)
+    if b is PersonBackend.HOG:
+        return HogPeopleDetector(HogParams(scale_factor=config.hog_scale, nms_iou=config.nms_iou))
+    if config.source is None:
+        raise ConfigError("detector.person.source is required for backend 'recorded'")
+    recorded = RecordedParams(
+        tuple(config.classes), config.score_threshold, round(config.max_gap_ms * 1e6)
+    )
+    if config.source.suffix == ".txt":
+        return RecordedDetector.from_det_txt(config.source, recorded)
+    return RecordedDetector.from_topic(config.source, config.topic or "", recorded)
+
+
+def build_embedder(config: ReidConfig, threads: int = 1) -> Embedder:
+    """The re-ID embedder a config names."""
+    if config.backend is ReidBackend.COLOUR_TEXTURE:
+        return ColourTextureEmbedder()
+    if config.backend is ReidBackend.MOBILENET:
+        return builtin_mobilenet(threads)
+    if config.model is None:
+        raise ConfigError("detector.reid.model is required for backend 'onnx'")
+    params = OnnxEmbedderParams(
+        input_width=config.input_width,
+        input_height=config.input_height,
+        mean=config.mean,
+        std=config.std,
+        l2_normalise=config.l2_normalise,
+        threads=threads,
+    )
+    return OnnxEmbedder(config.model, params)
+
+
+def _build(config: Pinto2022DetectorConfig) -> Pinto2022Detector:
+    return Pinto2022Detector(
+        build_person_detector(config.person, config.threads),
+        build_embedder(config.reid, config.threads),
+    )
+
+
+def _contract(config: Pinto2022DetectorConfig) -> DetectionContract:
+    return DetectionContract(appearance=config.appearance_kind())
+
+
+SPEC = register_detector(
+    DetectorSpec(
+        name="pinto2022",
+        config_model=Pinto2022DetectorConfig,
+        factory=_build,
+        streams=(StreamSpec("colour"), StreamSpec("depth")),
+        contract=_contract,
+        stages=STAGES,
+        summary="2D CNN person detector, depth localiser (25th percentile), re-ID embedding "
+        "(seed 001, III-B)",
+    )
+)

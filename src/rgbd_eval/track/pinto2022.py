@@ -39,8 +39,10 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import kalman
-from rgbd_eval.types import Box2D, Detection, TrackOutput, TrackStatus, Visibility
+from rgbd_eval.track.pinto2022_config import Pinto2022TrackerConfig
+from rgbd_eval.types import Box2D, Detection, Frame, TrackOutput, TrackStatus, Visibility
 
 Array = NDArray[np.float64]
 
@@ -238,6 +240,7 @@ class Pinto2022Tracker:
 
     def __init__(self, params: Pinto2022Params | None = None) -> None:
         self.params = params or Pinto2022Params()
+        self._timings: dict[str, float] = {}
         self._tracks: list[_Track] = []
         self._id_dictionary: dict[int, list[Array]] = {}
         self._next_id = 1
@@ -248,8 +251,15 @@ class Pinto2022Tracker:
         """The ID dictionary ``I`` (III-E): galleries of deleted tracks per ID."""
         return self._id_dictionary
 
-    def update(self, stamp_ns: int, detections: Sequence[Detection]) -> list[TrackOutput]:
-        """Consume one frame's detections; return the Confirmed tracks."""
+    @property
+    def last_timings(self) -> Mapping[str, float]:
+        """The tracker does not split its work into timed stages."""
+        return self._timings
+
+    def update(
+        self, stamp_ns: int, detections: Sequence[Detection], frame: Frame | None = None
+    ) -> list[TrackOutput]:
+        """Consume one frame's detections (the frame is not used); return the Confirmed tracks."""
         if self._last_stamp_ns is not None and stamp_ns < self._last_stamp_ns:
             raise ValueError(f"stamps must not decrease: {stamp_ns} after {self._last_stamp_ns}")
         dt = 0.0 if self._last_stamp_ns is None else (stamp_ns - self._last_stamp_ns) * 1e-9
@@ -346,3 +356,50 @@ def _descriptors(detections: Sequence[Detection]) -> Array:
     if len(sizes) != 1:
         raise ConfigError(f"appearance descriptors differ in length: {sorted(sizes)}")
     return np.stack(rows)
+
+
+def params_from_config(config: Pinto2022TrackerConfig) -> Pinto2022Params:
+    """The tracker parameters of a validated config."""
+    return Pinto2022Params(
+        sigma_position=config.sigma_position,
+        sigma_velocity=config.sigma_velocity,
+        sigma_measurement=config.sigma_measurement,
+        t_lower=config.t_lower,
+        t_upper=config.t_upper,
+        s_max=config.s_max,
+        t_recover=config.t_recover,
+        confirm_hits=config.confirm_hits,
+        max_misses=config.max_misses,
+    )
+
+
+def check_contract(config: Pinto2022TrackerConfig, contract: DetectionContract) -> str | None:
+    """The tracker needs appearance embeddings in the units its thresholds are in."""
+    if contract.appearance is None:
+        return "the pinto2022 tracker needs detections with appearance embeddings"
+    if contract.appearance != config.appearance:
+        return (
+            f"the detector's appearance is {contract.appearance!r} but tracker.t_lower/t_upper/"
+            f"t_recover are in {config.appearance!r} units; recalibrate them "
+            "(tools/pinto2022/calibrate_reid.py) and set tracker.appearance"
+        )
+    return None
+
+
+def _build(config: Pinto2022TrackerConfig, contract: DetectionContract) -> Pinto2022Tracker:
+    problem = check_contract(config, contract)
+    if problem is not None:
+        raise ConfigError(problem)
+    return Pinto2022Tracker(params_from_config(config))
+
+
+SPEC = register_tracker(
+    TrackerSpec(
+        name="pinto2022",
+        config_model=Pinto2022TrackerConfig,
+        factory=_build,
+        check=check_contract,
+        summary="3D Kalman, appearance gallery + Mahalanobis gating, Hungarian, ID memory "
+        "(seed 001, III-C..E)",
+    )
+)
