@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Protocol
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
@@ -64,8 +65,6 @@ def letterbox(
     rgb: NDArray[np.uint8], width: int, height: int, fill: int = 114
 ) -> tuple[NDArray[np.uint8], Letterbox]:
     """Resize keeping the aspect ratio and pad (centred) to ``width x height`` (YOLO's letterbox)."""
-    import cv2
-
     h, w = rgb.shape[:2]
     scale = min(width / w, height / h)
     new_w, new_h = round(w * scale), round(h * scale)
