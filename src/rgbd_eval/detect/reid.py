@@ -169,8 +169,9 @@ class ColourTextureEmbedder:
     """Per horizontal stripe: a hue x saturation histogram and a gradient-orientation histogram.
 
     Each histogram is normalised to sum 1, square-rooted (Hellinger), and the concatenation is
-    L2-normalised; the entries are non-negative, so distances lie in [0, sqrt(2)]. Pixels with low saturation or value vote for
-    hue 0 with saturation bin 0 (greys), so achromatic clothes still have a colour signature.
+    L2-normalised; the entries are non-negative, so distances lie in [0, sqrt(2)]. Pixels with
+    low saturation or value vote for hue 0 with saturation bin 0 (greys), so achromatic
+    clothes still have a colour signature.
     """
 
     def __init__(self, params: ColourTextureParams | None = None) -> None:
