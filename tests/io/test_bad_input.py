@@ -72,9 +72,7 @@ def test_no_depth_topic(tmp_path: Path) -> None:
         w.write_rgb(T0, rgb_image(0), RGB_CAM)
     code, out = inspect(path, "--method", "basso2012")
     assert code == 3
-    assert_one_line_error(
-        out, "rgb_only.mcap", "no depth image topic found", "--topic depth=/name"
-    )
+    assert_one_line_error(out, "rgb_only.mcap", "no depth image topic found", "--topic depth=/name")
     code, out = inspect(path)  # without a method, inspect shows whatever streams there are
     assert code == 0, out
     assert "colour" in out

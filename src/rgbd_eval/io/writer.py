@@ -379,7 +379,9 @@ class RecordingWriter:
         else:
             raise ValueError(f"encoding={encoding!r}: expected rgb8, mono8, mono16, 16UC1 or 32FC1")
         header = self.header(stamp_ns, camera.frame_id, topic)
-        self.write_message(topic, IMAGE_TYPE, stamp_ns, self._t(IMAGE_TYPE)(header=header, **fields))
+        self.write_message(
+            topic, IMAGE_TYPE, stamp_ns, self._t(IMAGE_TYPE)(header=header, **fields)
+        )
         self.write_message(
             info_topic, CAMERA_INFO_TYPE, stamp_ns, self.camera_info(stamp_ns, camera, info_topic)
         )

@@ -19,6 +19,7 @@ from rgbd_eval.config import data_home
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
 from rgbd_eval.sim import rig
+from rgbd_eval.sim.rig_sensors import make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
 from rgbd_eval.sim.simulate import SimFrame, Simulator
 from rgbd_eval.types import GroundTruthObject
@@ -112,8 +113,14 @@ def synthesize(
         w.write_static_transform(first, rig.BASE_FRAME, rig.CAMERA_LINK, sim.base_to_link)
         w.write_static_transform(first, rig.CAMERA_LINK, rig.RGB_FRAME, sim.link_to_rgb)
         w.write_static_transform(first, rig.CAMERA_LINK, rig.DEPTH_FRAME, sim.link_to_depth)
+        extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
+        for sensor in extra:
+            for parent, child, pose in sensor.static_transforms():
+                w.write_static_transform(first, parent, child, pose)
         for f in sim.frames(list(range(total))):
             _write_frame(w, sim, f)
+            for k, sensor in enumerate(extra):
+                sensor.write(w, sim.scene_view(f.index, k))
             truth.extend(f.ground_truth)
             if progress is not None:
                 progress(f.index + 1, total)
