@@ -144,7 +144,13 @@ def _build(config: Pinto2022DetectorConfig) -> Pinto2022Detector:
 
 
 def _contract(config: Pinto2022DetectorConfig) -> DetectionContract:
-    return DetectionContract(appearance=config.appearance_kind())
+    """Detections carry a world position, the box and an embedding of the configured kind."""
+    sizes = {
+        ReidBackend.COLOUR_TEXTURE: ColourTextureEmbedder().dimension,
+        ReidBackend.MOBILENET: 1280,
+    }
+    size = sizes.get(config.reid.backend, 0)  # an ONNX file's size is known once it is loaded
+    return DetectionContract(appearance=config.appearance_kind(), appearance_size=size)
 
 
 SPEC = register_detector(
