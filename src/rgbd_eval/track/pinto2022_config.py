@@ -28,9 +28,9 @@ class Pinto2022TrackerConfig(ComponentConfig):
     appearance: str = Field(
         "colour_texture", description="the embedder whose units t_lower/t_upper/t_recover are in"
     )
-    t_lower: float = Field(0.376, ge=0.0, description="eq. 17 T_lower, in the embedder's units")
-    t_upper: float = Field(0.573, ge=0.0, description="eq. 17 T_upper, in the embedder's units")
-    t_recover: float = Field(0.476, ge=0.0, description="eq. 18 T_recover, in the embedder's units")
+    t_lower: float = Field(0.359, ge=0.0, description="eq. 17 T_lower, in the embedder's units")
+    t_upper: float = Field(0.646, ge=0.0, description="eq. 17 T_upper, in the embedder's units")
+    t_recover: float = Field(0.486, ge=0.0, description="eq. 18 T_recover, in the embedder's units")
     confirm_hits: int = Field(3, ge=1, description="III-E: associations to confirm a track")
     max_misses: int = Field(5, ge=1, description="III-E: consecutive misses to delete a track")
 
