@@ -7,7 +7,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DEMO   := datasets/demo.mcap
 
-.PHONY: setup system-deps run test test-fast lint datasets bench clean
+.PHONY: setup system-deps test-deps run test test-fast lint datasets bench clean
 
 # open3d needs the system library libusb-1.0 to import on a bare Debian machine.
 system-deps:
@@ -17,11 +17,23 @@ system-deps:
 		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq libusb-1.0-0 >/dev/null; \
 	fi
 
+# The HTML report tests open each page in a real headless browser (Debian's chromium).
+test-deps:
+	@if ! command -v chromium >/dev/null 2>&1; then \
+		echo "installing chromium (headless browser for the HTML report tests)"; \
+		SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq -o DPkg::Lock::Timeout=900 --no-install-recommends chromium >/dev/null; \
+	fi
+
 $(STAMP): pyproject.toml
 	@$(MAKE) --no-print-directory system-deps
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e ".[dev]"
+	@# Test-only parity reference of the `motchallenge` convention (TrackEval, PyPI packaging).
+	@# Without its dependencies: it requires opencv-python, which would shadow our headless
+	@# OpenCV; its metrics need only numpy and scipy.
+	$(BIN)/python -m pip install -q --no-deps "trackeval==1.3.0"
 	@touch $(STAMP)
 
 setup: $(STAMP)
@@ -52,7 +64,7 @@ bench: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval bench $(DEMO) --method pinto2022 --repeat 1 --json > runs/bench/demo_pinto2022.json
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
 
-test: $(STAMP)
+test: $(STAMP) test-deps
 	$(BIN)/python -m pytest -q
 
 test-fast: $(STAMP)

@@ -1,4 +1,4 @@
-"""Reports of runs: JSON for machines, Markdown and terminal tables for people, CSVs, plots.
+"""Reports of runs: JSON for machines, Markdown and terminal tables for people, CSVs.
 
 A run's output folder is written under a temporary name and renamed when
 complete, so a failed run never leaves a half-written ``report.json`` that a
@@ -10,23 +10,21 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
-import os
-import shutil
-import tempfile
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
 from typing import Any
 
 from rgbd_eval import __version__
-from rgbd_eval.config import Gating, RunConfig, config_to_dict
-from rgbd_eval.errors import ConfigError
-from rgbd_eval.metrics import Counts, Summary, summarize, total
+from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
+from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
+from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.pipeline import SequenceResult
 
 REPORT_SCHEMA_VERSION = 1
+#: The file that marks a run folder as ours (and that ``compare`` reads).
+REPORT_FILE = "report.json"
 _LIBRARIES = (
     "numpy",
     "scipy",
@@ -35,7 +33,6 @@ _LIBRARIES = (
     "open3d",
     "rosbags",
     "mcap",
-    "motmetrics",
     "pydantic",
 )
 
@@ -49,11 +46,21 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("main_tr", "Main Tr.", "pct"),
     ("all_tr", "All Tr.", "pct"),
     ("idf1", "IDF1", "pct"),
+    ("hota", "HOTA", "pct"),
     ("mt", "MT", "int"),
     ("ml", "ML", "int"),
     ("fragmentations", "Frag.", "int"),
     ("recall_errors", "Rec. err.", "int"),
 )
+
+
+#: How each convention matches, for the report header.
+MATCHING = {
+    Convention.MOTCHALLENGE: "motchallenge (devkit/TrackEval): a previous match is kept only "
+    "from the previous frame; MT means tracked in more than 80% of frames",
+    Convention.MOTMETRICS: "motmetrics 1.4: a previous match is kept while it stays within "
+    "the gate, however long ago; MT means tracked in 80% of frames or more",
+}
 
 
 def file_digest(path: Path) -> str:
@@ -185,7 +192,8 @@ def report_dict(
             "motp": "mean IoU of matches (higher is better)"
             if gating is Gating.IOU
             else "mean ground-plane distance of matches in metres (lower is better)",
-            "matching": "motmetrics: a previous match is kept while it stays within the gate",
+            "convention": config.evaluation.convention.value,
+            "matching": MATCHING[config.evaluation.convention],
         },
         "config": config_to_dict(config),
         "sequences": [sequence_record(r, d) for r, d in zip(results, digests, strict=True)],
@@ -283,90 +291,77 @@ def tracks_csv(r: SequenceResult) -> str:
     return _csv(rows, header)
 
 
-def birds_eye_png(r: SequenceResult, path: Path) -> None:
-    """Ground-truth (dashed) and tracked (solid) ground-plane trajectories of one sequence."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
-    cmap = plt.get_cmap("tab10")
-    if r.ground_truth is not None:
-        paths: dict[int, list[tuple[float, float]]] = {}
-        for frame in r.ground_truth.frames:
-            for o in frame:
-                if o.world_xyz is not None and not o.ignore:
-                    paths.setdefault(o.object_id, []).append((o.world_xyz[0], o.world_xyz[1]))
-        for k, (oid, pts) in enumerate(sorted(paths.items())):
-            xs, ys = zip(*pts, strict=True)
-            ax.plot(xs, ys, "--", color="0.5", lw=1.5, label="ground truth" if k == 0 else None)
-            ax.annotate(f"gt {oid}", pts[0], color="0.4", fontsize=8)
-    tracks: dict[int, list[tuple[float, float]]] = {}
-    for frame_tracks in r.tracks:
-        for t in frame_tracks:
-            if t.visibility.name != "NOT_VISIBLE" and t.status.value == "validated":
-                tracks.setdefault(t.track_id, []).append((t.x, t.y))
-    for tid, pts in sorted(tracks.items()):
-        xs, ys = zip(*pts, strict=True)
-        ax.plot(xs, ys, "-", color=cmap(tid % 10), lw=1.2, label=f"track {tid}")
-    ax.set_xlabel(f"x [m] ({r.info.world_frame})")
-    ax.set_ylabel(f"y [m] ({r.info.world_frame})")
-    ax.set_title(f"{r.name}: bird's-eye view")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
-    if tracks or r.ground_truth is not None:
-        ax.legend(fontsize=7, loc="best", ncol=2)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
+EVENTS_HEADER = ("frame", "stamp_ns", "event", "gt_id", "track_id", "similarity", "recall_error")
 
 
-@contextmanager
-def staged_output(out_dir: Path) -> Iterator[Path]:
-    """A temporary folder beside ``out_dir`` that replaces it only if the block succeeds."""
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    if out_dir.exists() and any(out_dir.iterdir()) and not (out_dir / "report.json").exists():
-        raise ConfigError(
-            f"{out_dir}: exists and is not an rgbd-eval output folder; choose another --out"
-        )
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    os.replace(tmp, out_dir)
+def events_csv(
+    frames: Sequence[FrameEvents],
+    stamps_ns: Sequence[int],
+    frame_numbers: Sequence[int] | None = None,
+) -> str:
+    """Per-frame scoring events: one row per match/switch, miss, false positive, ignored object.
+
+    ``similarity`` is the IoU (IoU gating) or the distance in metres (metric gating) of a
+    match; ``switch`` rows are matches that are id switches. ``frame`` is the frame index,
+    or the input's own frame number (MOTChallenge counts from 1) where given.
+    """
+    rows: list[list[object]] = []
+    numbers = frame_numbers if frame_numbers is not None else [e.frame for e in frames]
+    for events, stamp, f in zip(frames, stamps_ns, numbers, strict=True):
+        for m in events.matches:
+            kind = "switch" if m.id_switch else "match"
+            rows.append(
+                [f, stamp, kind, m.gt_id, m.track_id, f"{m.similarity:.6f}", int(m.recall_error)]
+            )
+        rows += [[f, stamp, "miss", g, "", "", ""] for g in events.misses]
+        rows += [[f, stamp, "fp", "", t, "", ""] for t in events.false_positives]
+        rows += [[f, stamp, "ignored_gt", g, "", "", ""] for g in events.ignored_gt]
+        rows += [[f, stamp, "ignored_track", "", t, "", ""] for t in events.ignored_tracks]
+    return _csv(rows, EVENTS_HEADER)
 
 
 def write_run(
-    out_dir: Path, results: Sequence[SequenceResult], config: RunConfig
+    out: Path | OutputFolder,
+    results: Sequence[SequenceResult],
+    config: RunConfig,
+    also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write every output of a run into ``out_dir`` (atomically as a folder); return the report."""
+    """Write every output of a run into ``out`` (published when complete); return the report.
+
+    ``out`` is a folder path, or an :class:`OutputFolder` prepared before the pipeline ran.
+    ``also(folder, report)`` writes further outputs (the HTML page and its plots) into the
+    staged folder.
+    """
     import json
 
     digests = [file_digest(Path(r.path)) for r in results]
     report = report_dict(results, config, digests)
-    with staged_output(out_dir) as tmp:
+    folder = out if isinstance(out, OutputFolder) else OutputFolder(out, REPORT_FILE)
+    with folder:
+        tmp = folder.staging
         for r in results:
             (tmp / f"{r.name}.detections.csv").write_text(detections_csv(r), encoding="utf-8")
             (tmp / f"{r.name}.tracks.csv").write_text(tracks_csv(r), encoding="utf-8")
-            birds_eye_png(r, tmp / f"{r.name}.birdseye.png")
+            if r.scores is not None:
+                (tmp / f"{r.name}.events.csv").write_text(
+                    events_csv(r.scores.frames, r.detections.stamps_ns), encoding="utf-8"
+                )
         md = [
             f"# rgbd-eval run: {config.method}",
             "",
             f"Gating: {report['evaluation']['gating']} (threshold {report['evaluation']['threshold']}); "
             f"MOTP is the {report['evaluation']['motp']}.",
+            f"Convention: {report['evaluation']['matching']}.",
             "",
         ]
         if any(r.scores is not None for r in results):
             md.append(markdown_table(results, config.evaluation.gating))
         md += [f"- {note}" for note in run_notes(results)]
         (tmp / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-        (tmp / "report.json").write_text(
+        (tmp / REPORT_FILE).write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
+        if also is not None:
+            also(tmp, report)
+        folder.commit()
     return report

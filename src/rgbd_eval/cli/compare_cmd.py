@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from rgbd_eval.atomic import write_text
-from rgbd_eval.cli.common import console, handle_errors
+from rgbd_eval.cli.common import console, handle_errors, one_line
 
 
 @handle_errors
@@ -24,6 +24,9 @@ def compare(
         Path | None, typer.Option("--markdown", help="also write the table as Markdown")
     ] = None,
     all_rows: Annotated[bool, typer.Option("--all", help="show unchanged metrics too")] = False,
+    html_file: Annotated[
+        Path | None, typer.Option("--html", help="also write the deltas as an HTML page")
+    ] = None,
 ) -> None:
     """Per sequence and overall, what got better and what got worse; exit 1 on regression."""
     from rgbd_eval.compare import (  # heavy (report -> metrics -> motmetrics/pandas): only here
@@ -55,10 +58,20 @@ def compare(
         console.print(f"config: {change}")
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison))
+    if html_file is not None:
+        from rgbd_eval.report_html import compare_page
+
+        write_text(html_file, compare_page(comparison, str(baseline), str(current)))
     if comparison.regressions:
-        names = ", ".join(f"{d.sequence}/{d.metric}" for d in comparison.regressions)
-        console.print(
-            f"[bold red]{len(comparison.regressions)} regression(s) beyond tolerance:[/] {names}"
-        )
+        lost = [d for d in comparison.regressions if d.status is Status.MISSING]
+        worse = [d for d in comparison.regressions if d.status is Status.REGRESSED]
+        reasons = []
+        if worse:
+            names = ", ".join(f"{d.sequence}/{d.metric}" for d in worse)
+            reasons.append(f"{len(worse)} regression(s) beyond tolerance: {names}")
+        if lost:
+            names = ", ".join(f"{d.sequence}/{d.metric}" for d in lost)
+            reasons.append(f"{len(lost)} metric(s) scored in the baseline but missing now: {names}")
+        typer.echo(f"error: {one_line('; '.join(reasons))}", err=True)
         raise typer.Exit(1)
     console.print("no regression beyond tolerance")

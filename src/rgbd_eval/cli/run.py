@@ -21,6 +21,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.errors import InputError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.pipeline import SequenceResult
@@ -118,11 +119,20 @@ def run(
     json_out: Annotated[
         bool, typer.Option("--json", help="print report.json on stdout instead of a table")
     ] = False,
+    video: Annotated[
+        bool,
+        typer.Option("--video", help="also write <name>.overlay.mp4: tracks on the RGB frames"),
+    ] = False,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
-    from rgbd_eval.report import write_run
+    from rgbd_eval.report import REPORT_FILE, write_run
+    from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:
@@ -140,16 +150,25 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with progress_bar() as bar:
-        for path in recordings:
+    with OutputFolder(out_dir, REPORT_FILE, force) as folder, progress_bar() as bar:
+        for path in recordings:  # the output folder is checked and staged before this work
             task = bar.add_task(path.name, total=None)
             results.append(run_sequence(path, config, gt, advance_callback(bar, task)))
             bar.remove_task(task)
-    report = write_run(out_dir, results, config)
+        task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
+        report = write_run(
+            folder,
+            results,
+            config,
+            lambda staging, rep: write_run_html(
+                staging, results, config, rep, video, advance_callback(bar, task)
+            ),
+        )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:
         print_table(results, config)
         console.print(
-            f"report: {out_dir / 'report.md'} (machine-readable: {out_dir / 'report.json'})"
+            f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
+            f"(machine-readable: {out_dir / 'report.json'})"
         )

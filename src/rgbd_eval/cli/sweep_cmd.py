@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -20,44 +21,10 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.sweep import SweepResult
-
-_PLOTTED = (("mota", "MOTA"), ("fp_rate", "FP"), ("fn_rate", "FN"))
-
-
-def sweep_plot(result: SweepResult, path: Path) -> None:
-    """MOTA, FP, FN (%) and ID switches against the swept value (seed 000, Figure 7.10)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    key = result.params[0]
-    pts = result.overall()
-    xs = [float(p[key]) for p, _ in pts]
-    from rgbd_eval.metrics import summarize
-
-    sums = [summarize(c) for _, c in pts]
-    fig, ax = plt.subplots(figsize=(7, 4.5), dpi=100)
-    for metric, label in _PLOTTED:
-        ax.plot(xs, [100 * float(s[metric] or 0.0) for s in sums], "o-", label=f"{label} (%)")
-    ax.set_xlabel(key)
-    ax.set_ylabel("%")
-    ax2 = ax.twinx()
-    ax2.plot(
-        xs, [int(s["id_switches"] or 0) for s in sums], "s--", color="tab:red", label="ID switches"
-    )
-    ax2.set_ylabel("ID switches")
-    lines = ax.get_legend_handles_labels()
-    lines2 = ax2.get_legend_handles_labels()
-    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="center right", fontsize=8)
-    ax.grid(True, alpha=0.3)
-    ax.set_title("sweep (all sequences summed)")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
 
 
 def _csv(rows: list[dict[str, Any]]) -> str:
@@ -66,6 +33,42 @@ def _csv(rows: list[dict[str, Any]]) -> str:
     writer.writeheader()
     writer.writerows(rows)
     return buf.getvalue()
+
+
+def _write_outputs(
+    folder: OutputFolder,
+    result: SweepResult,
+    wall: float,
+    method: str,
+    recordings: list[Path],
+    fixed: list[str],
+    gating: Gating,
+) -> None:
+    """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
+    folder, then publish."""
+    from rgbd_eval.report_html import write_sweep_html
+
+    tmp = folder.staging
+    rows = result.rows()
+    (tmp / "sweep.csv").write_text(_csv(rows), encoding="utf-8")
+    write_sweep_html(tmp, result, method, [str(p) for p in recordings], fixed, gating)
+    record = {
+        "schema_version": SCHEMA_VERSION,
+        "params": list(result.params),
+        "method": method,
+        "datasets": [str(p) for p in recordings],
+        "fixed": fixed,
+        "records": rows,
+        "seconds": {
+            "wall": wall,
+            "detect": result.detect_seconds,
+            "track_score": result.track_seconds,
+        },
+        "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
+    }
+    text = json.dumps(record, indent=2, allow_nan=False) + "\n"
+    (tmp / "sweep.json").write_text(text, encoding="utf-8")
+    folder.commit()
 
 
 @handle_errors
@@ -95,11 +98,14 @@ def sweep(
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
-    from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.config import load_config
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
@@ -146,32 +152,13 @@ def sweep(
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
     jobs = jobs if jobs is not None else default_jobs()
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
-    start = time.perf_counter()
-    result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
-    wall = time.perf_counter() - start
-    rows = result.rows()
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_text(out_dir / "sweep.csv", _csv(rows))
-    write_json(
-        out_dir / "sweep.json",
-        {
-            "schema_version": SCHEMA_VERSION,
-            "params": list(result.params),
-            "method": method,
-            "datasets": [str(p) for p in recordings],
-            "fixed": fixed,
-            "records": rows,
-            "seconds": {
-                "wall": wall,
-                "detect": result.detect_seconds,
-                "track_score": result.track_seconds,
-            },
-            "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
-        },
-    )
-    if len(result.params) == 1:
-        sweep_plot(result, out_dir / "sweep.png")
     g = configs[0].evaluation.gating if configs else Gating.IOU
+    folder = OutputFolder(out_dir, "sweep.json", force)
+    with folder:  # checked and staged before the sweep; published whole or not at all
+        start = time.perf_counter()
+        result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
+        wall = time.perf_counter() - start
+        _write_outputs(folder, result, wall, method, recordings, fixed, g)
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:
@@ -194,5 +181,6 @@ def sweep(
     console.print(table)
     console.print(
         f"wall {wall:.1f} s (detect {result.detect_seconds:.1f} s, track+score {result.track_seconds:.1f} s); "
-        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
+        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); "
+        f"records: {out_dir / 'sweep.csv'}, page: {out_dir / 'sweep.html'}"
     )

@@ -2,10 +2,11 @@
 
 The ground-truth topic carries ``rgbd_eval_msgs/msg/GroundTruthArray``; its
 definition is registered with every typestore this module hands out, and the
-ROS1 Noetic typestore also gets ``tf2_msgs/msg/TFMessage``, which it lacks.
-Recorded 2D detections (``vision_msgs/Detection2DArray`` in its ROS1 Noetic 1.x and
-ROS2 Humble 4.x forms, ``darknet_ros_msgs/BoundingBoxes``) are registered too: neither
-stock typestore has them.
+ROS1 Noetic typestore also gets ``tf2_msgs/msg/TFMessage``, which it lacks. The
+people-tracker output types ``rgbd-eval score`` reads are registered too
+(:mod:`rgbd_eval.io.track_message_types`, which includes ``vision_msgs``), and so is
+``darknet_ros_msgs/BoundingBoxes`` (recorded 2D detections): neither stock typestore
+has them.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ from typing import Literal
 
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
+
+from rgbd_eval.io.track_message_types import track_message_definitions
 
 GT_PERSON_TYPE = "rgbd_eval_msgs/msg/GroundTruthPerson"
 GT_ARRAY_TYPE = "rgbd_eval_msgs/msg/GroundTruthArray"
@@ -44,31 +47,6 @@ rgbd_eval_msgs/GroundTruthPerson[] people
 
 TF_MESSAGE_MSG = "geometry_msgs/TransformStamped[] transforms\n"
 
-VISION_ROS1_MSGS = {
-    "vision_msgs/msg/BoundingBox2D": "geometry_msgs/Pose2D center\nfloat64 size_x\nfloat64 size_y\n",
-    "vision_msgs/msg/ObjectHypothesisWithPose": (
-        "int64 id\nfloat64 score\ngeometry_msgs/PoseWithCovariance pose\n"
-    ),
-    "vision_msgs/msg/Detection2D": (
-        "std_msgs/Header header\nvision_msgs/ObjectHypothesisWithPose[] results\n"
-        "vision_msgs/BoundingBox2D bbox\nsensor_msgs/Image source_img\n"
-    ),
-    "vision_msgs/msg/Detection2DArray": "std_msgs/Header header\nvision_msgs/Detection2D[] detections\n",
-}
-VISION_ROS2_MSGS = {
-    "vision_msgs/msg/Point2D": "float64 x\nfloat64 y\n",
-    "vision_msgs/msg/Pose2D": "vision_msgs/Point2D position\nfloat64 theta\n",
-    "vision_msgs/msg/BoundingBox2D": "vision_msgs/Pose2D center\nfloat64 size_x\nfloat64 size_y\n",
-    "vision_msgs/msg/ObjectHypothesis": "string class_id\nfloat64 score\n",
-    "vision_msgs/msg/ObjectHypothesisWithPose": (
-        "vision_msgs/ObjectHypothesis hypothesis\ngeometry_msgs/PoseWithCovariance pose\n"
-    ),
-    "vision_msgs/msg/Detection2D": (
-        "std_msgs/Header header\nvision_msgs/ObjectHypothesisWithPose[] results\n"
-        "vision_msgs/BoundingBox2D bbox\nstring id\n"
-    ),
-    "vision_msgs/msg/Detection2DArray": "std_msgs/Header header\nvision_msgs/Detection2D[] detections\n",
-}
 DARKNET_MSGS = {
     "darknet_ros_msgs/msg/BoundingBox": (
         "float64 probability\nint64 xmin\nint64 ymin\nint64 xmax\nint64 ymax\nint16 id\nstring Class\n"
@@ -97,8 +75,7 @@ def extra_types(ros_version: RosVersion) -> dict[str, tuple[list[object], list[o
     types.update(get_types_from_msg(GT_ARRAY_MSG, GT_ARRAY_TYPE))  # type: ignore[arg-type]
     if ros_version == 1:
         types.update(get_types_from_msg(TF_MESSAGE_MSG, TF_TYPE))  # type: ignore[arg-type]
-    vision = VISION_ROS1_MSGS if ros_version == 1 else VISION_ROS2_MSGS
-    for name, text in (*vision.items(), *DARKNET_MSGS.items()):
+    for name, text in (*track_message_definitions(ros_version).items(), *DARKNET_MSGS.items()):
         types.update(get_types_from_msg(text, name))  # type: ignore[arg-type]
     return types
 
