@@ -166,7 +166,7 @@ class Basso2012Tracker:
                 raise ValueError(f"detection position {d.position} is not finite")
             if not (math.isfinite(d.distance) and d.distance >= 0.0):
                 raise ValueError(f"detection distance={d.distance} must be finite and >= 0")
-            if d.appearance is not None and d.appearance.shape != (size,):
+            if self._cfg.classifier and d.appearance is not None and d.appearance.shape != (size,):
                 raise ValueError(
                     f"detection appearance has shape {d.appearance.shape}, expected ({size},) "
                     f"for histogram_bins={self._bins}"
