@@ -216,6 +216,21 @@ class TrackerConfig(_Model):
         description="floor of the gain of the weak classifiers' running class means "
         "(seed 000 6.5.3 follows Grabner and Bischof [13]; the value is not given)",
     )
+    static_devalidation_s: float | None = Field(
+        None,
+        gt=0.0,
+        le=600.0,
+        description="beyond the thesis, off by default: discard a validated track whose "
+        "detections for this many seconds all scored at or below min_confidence and stayed "
+        "within static_motion_m of their mean (a track held by a coat stand or a mannequin)",
+    )
+    static_motion_m: float = Field(
+        0.3,
+        gt=0.0,
+        le=5.0,
+        description="largest distance (m) from the window's mean position that counts as "
+        "not moving, for static_devalidation_s",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> TrackerConfig:

@@ -23,12 +23,14 @@ def reproduce(
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
 ) -> None:
-    """Redo the thesis' experiments on the six synthetic scenarios (generated if absent)."""
+    """Redo the thesis' experiments on the six synthetic scenarios, plus the two clutter ones
+    for the tracker's static variant (all generated if absent)."""
     if system != "basso2012":
         raise ConfigError(f"reproduce {system!r}: only basso2012 is available")
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.datasets import scenarios_dir
     from rgbd_eval.reproduce import (
+        CLUTTER,
         SCENARIOS,
         paper_values,
         render_markdown,
@@ -39,7 +41,7 @@ def reproduce(
     from rgbd_eval.sweep import default_jobs
 
     recordings = {}
-    for name in SCENARIOS:
+    for name in (*SCENARIOS, *CLUTTER):
         path = dataset_path(name)
         if not path.exists():
             err_console.print(f"generating {path} ...")
