@@ -608,7 +608,12 @@ def render_markdown(res: Reproduction, paper: Mapping[str, Any]) -> str:
         ]
     other = {k: v for k, v in res.frame_rates.items() if not k.startswith("Table 7.1")}
     if other:
-        out += ["### Frame rates of this run", "", "| | frames | seconds | fps |", "|---|---|---|---|"]
+        out += [
+            "### Frame rates of this run",
+            "",
+            "| | frames | seconds | fps |",
+            "|---|---|---|---|",
+        ]
         for label, r in other.items():
             out.append(f"| {label} | {r['frames']:.0f} | {r['seconds']:.1f} | {r['fps']:.1f} |")
         out.append("")
@@ -630,7 +635,7 @@ def render_markdown(res: Reproduction, paper: Mapping[str, Any]) -> str:
     out += ["## Claims of the thesis", ""]
     for c in res.claims:
         out.append(
-            f"- **{'held' if c.held else 'did not hold'}** ({c.source}) \"{c.sentence}\": "
+            f'- **{"held" if c.held else "did not hold"}** ({c.source}) "{c.sentence}": '
             f"tested as {c.text}. {c.evidence}."
         )
     return "\n".join(out) + "\n"
