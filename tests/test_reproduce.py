@@ -154,13 +154,23 @@ def test_paper_values_file_problems_are_config_errors(tmp_path: Path) -> None:
         paper_values(bad)
 
 
+def test_two_scenarios_on_one_file_name_are_refused(tmp_path: Path) -> None:
+    one = tmp_path / "a" / "x.mcap"
+    other = tmp_path / "b" / "x.mcap"
+    with pytest.raises(ConfigError, match="two scenarios share one recording file name"):
+        reproduce_basso2012({"static_simple": one, "moving_simple": other})
+
+
 @pytest.mark.slow
 def test_small_reproduction_runs(tmp_path: Path) -> None:
     scenario = load_scenario(scenarios_dir() / "demo.yaml")
     obstacles = synthesize(scenario, tmp_path / "moving_obstacles.mcap", max_frames=25).recording
     complex_ = synthesize(scenario, tmp_path / "moving_complex.mcap", max_frames=20).recording
+    clutter_sc = load_scenario(scenarios_dir() / "static_clutter.yaml")
+    clutter = synthesize(clutter_sc, tmp_path / "static_clutter.mcap", max_frames=15).recording
     res = reproduce_basso2012(
-        {"moving_obstacles": obstacles, "moving_complex": complex_}, cache=tmp_path / "cache"
+        {"moving_obstacles": obstacles, "moving_complex": complex_, "static_clutter": clutter},
+        cache=tmp_path / "cache",
     )
     assert set(res.tables["7.4"]) == {"height", "confidence"}
     assert len(res.tables["7.6"]) == len(THRESHOLDS)
@@ -168,4 +178,10 @@ def test_small_reproduction_runs(tmp_path: Path) -> None:
     assert len(res.voxel_timing) == 6 and all(
         t["total_detect"] > 0 for t in res.voxel_timing.values()
     )
-    assert res.claims and "Table 7.2" in render_markdown(res, paper_values())
+    assert set(res.clutter) == {"thesis", "static 2 s"}
+    assert set(res.clutter["thesis"]) == {"static_clutter"}
+    (t71,) = (v for k, v in res.frame_rates.items() if k.startswith("Table 7.1"))
+    assert 0 < t71["detector_tracker_fps"] < t71["detector_fps"]
+    text = render_markdown(res, paper_values())
+    assert res.claims and "Table 7.2" in text and "detector + tracker fps" in text
+    assert "| static 2 s | static_clutter |" in text

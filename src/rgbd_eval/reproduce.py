@@ -17,7 +17,7 @@ from typing import Any
 from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.config import RunConfig, build_config, load_config, load_yaml, repo_root
 from rgbd_eval.detect.protocol import create_detector
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.errors import ConfigError, InputError
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import SequenceDetections, detect_sequence, sequence_name, track_sequence
@@ -191,7 +191,7 @@ def voxel_timing(
             if n >= frames:
                 break
         if n == 0:
-            raise ConfigError(f"{recording}: no frames to time the detector on")
+            raise InputError(recording, "no frames to time the detector on")
         out[v] = {k: 1000.0 * s / n for k, s in sums.items()}
     return out
 
