@@ -52,6 +52,20 @@ class GroundMode(enum.Enum):
     PLANE = "plane"
 
 
+class HogClassifier(enum.Enum):
+    """Which person classifier scores the clusters (seed 000, 5.4.2)."""
+
+    AUTHORS = "authors"  # Dollár's HOG + the authors' SVM: the thesis' confidence units
+    OPENCV = "opencv"  # OpenCV's Dalal-Triggs INRIA people detector: another scale
+
+
+class HogBorder(enum.Enum):
+    """Clusters whose person window is not wholly visible (seed 000, 5.4.2)."""
+
+    SKIP = "skip"  # the thesis: not scored, hog_default_confidence (-100)
+    PAD = "pad"  # the authors' later code (PCL): scored, the window's outside black
+
+
 class DetectorConfig(_Model):
     """The basso2012 detector (seed 000, chapter 5; defaults from Table 5.1, voxel 0.06 m)."""
 
@@ -120,6 +134,17 @@ class DetectorConfig(_Model):
         description="move the head centroid from the visible surface to the head's axis "
         "(4/3 of the across-view spread, exact for a sphere or upright cylinder); off = the "
         "surface mean of 5.3",
+    )
+    hog: HogClassifier = Field(
+        HogClassifier.AUTHORS,
+        description="person classifier: 'authors' (Dollár's HOG and the thesis authors' SVM, "
+        "the units of the thesis' confidence thresholds) or 'opencv' (INRIA people detector)",
+    )
+    hog_border: HogBorder = Field(
+        HogBorder.SKIP,
+        description="'skip': clusters not visible top to bottom get hog_default_confidence "
+        "(the thesis, 5.4.2); 'pad': they are scored with the window's outside filled black "
+        "(the authors' later PCL code)",
     )
     hog_max_ground_gap: float = Field(
         0.3,

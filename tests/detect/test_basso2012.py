@@ -11,7 +11,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rgbd_eval.config import DetectorConfig, GroundMode, RunConfig
+from rgbd_eval.config import DetectorConfig, GroundMode, HogBorder, HogClassifier, RunConfig
 from rgbd_eval.detect import create_detector, known_detectors
 from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
 from rgbd_eval.errors import ConfigError
@@ -216,6 +216,27 @@ def test_person_cut_by_the_image_top_is_flagged_and_not_hog_scored() -> None:
     assert len(dets) == 1
     assert dets[0].occluded
     assert dets[0].confidence == -100.0
+
+
+@pytest.mark.parametrize("hog", [HogClassifier.AUTHORS, HogClassifier.OPENCV])
+def test_pad_scores_the_person_cut_by_the_image_top(hog: HogClassifier) -> None:
+    # As above; with hog_border 'pad' the window's part above the image is black and
+    # the cluster gets a real confidence (the authors' later behaviour), still flagged.
+    frame = render(Scene(people=[Person(3.0, 0.2)]), camera_pose(height=1.2, pitch_deg=15))
+    skip = _detect(frame, DetectorConfig(hog=hog))
+    pad = _detect(frame, DetectorConfig(hog=hog, hog_border=HogBorder.PAD))
+    assert skip[0].confidence == -100.0
+    assert len(pad) == 1 and pad[0].occluded
+    assert -10.0 < pad[0].confidence < 10.0
+
+
+def test_classifiers_give_different_scales_on_the_same_person() -> None:
+    frame = render(Scene(people=[Person(3.5, 0.0, 1.75)]), camera_pose(height=1.0))
+    authors = _detect(frame, DetectorConfig(hog=HogClassifier.AUTHORS))[0]
+    opencv = _detect(frame, DetectorConfig(hog=HogClassifier.OPENCV))[0]
+    # Same cluster, same geometry; only the confidence differs.
+    assert authors.position == opencv.position and authors.box2d == opencv.box2d
+    assert authors.confidence != opencv.confidence
 
 
 @pytest.mark.parametrize("odometry", [True, False])

@@ -22,7 +22,8 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import DetectorConfig, RunConfig
+from rgbd_eval.config import DetectorConfig, HogBorder, HogClassifier, RunConfig
+from rgbd_eval.detect.authors_hog import PersonWindow, person_confidences
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -82,6 +83,7 @@ class _Candidate:
         box3d: Box3D,
         occluded: bool,
         hog_eligible: bool,
+        window: PersonWindow,
         appearance: NDArray[np.float32],
     ) -> None:
         self.geometry = geometry
@@ -89,6 +91,7 @@ class _Candidate:
         self.box3d = box3d
         self.occluded = occluded
         self.hog_eligible = hog_eligible
+        self.window = window
         self.appearance = appearance
 
 
@@ -126,16 +129,25 @@ class Basso2012Detector:
                 return []
             candidates = self._candidates(frame, plane, cloud, grid, clock)
             confidences = np.full(len(candidates), cfg.hog_default_confidence)
-            eligible = [i for i, c in enumerate(candidates) if c.hog_eligible]
+            eligible = [
+                i
+                for i, c in enumerate(candidates)
+                if c.hog_eligible or cfg.hog_border is HogBorder.PAD
+            ]
             if eligible:
-                scores = hog_confidences(frame.rgb, [candidates[i].box for i in eligible])
-                confidences[eligible] = scores
+                confidences[eligible] = self._classify(frame, [candidates[i] for i in eligible])
             clock.lap("hog")
             return self._detections(frame, candidates, confidences)
         finally:
             self.last_timings = clock.timings
 
     # ------------------------------------------------------------------ stages
+
+    def _classify(self, frame: Frame, candidates: list[_Candidate]) -> FloatArray:
+        """Person-classifier confidences of ``candidates`` (``detector.hog``)."""
+        if self.config.hog is HogClassifier.OPENCV:
+            return hog_confidences(frame.rgb, [c.box for c in candidates])
+        return person_confidences(frame.rgb, [c.window for c in candidates])
 
     def _rays_for(self, camera: CameraModel) -> FloatArray:
         rays = self._rays.get(camera)
@@ -291,13 +303,17 @@ class Basso2012Detector:
                 and box.bottom <= frame.rgb_camera.height - 0.5
                 and 0.0 <= centre_u < frame.rgb_camera.width
             )
+            # The authors' window (PCL): as tall as the head-to-ground projection,
+            # centred on the projected mid point of the person's axis.
+            mid_uv, _ = project(g.theoretical_centroid[None, :])
+            window = PersonWindow(box.height, float(mid_uv[0, 0]), float(mid_uv[0, 1]))
             blob_uv, _ = project(np.take(cloud.points, members(c), axis=0))
             appearance = colour_histogram(
                 frame.rgb, blob(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
             )
             box3d = _world_box(frame, np.vstack([np.take(pts, mine, axis=0), g.ground_point]))
             candidates.append(
-                (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, appearance))
+                (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, window, appearance))
             )
         return [c for _, c in candidates]
 
