@@ -17,7 +17,8 @@ static-camera scene:
 
 Each window is the full projected extent of the person or object (head to feet,
 as the detector's theoretical box, unclipped), scored by a classifier given as a
-function ``(rgb, box) -> confidence``. Runnable for the note::
+function ``(rgb, box) -> confidence``: OpenCV's INRIA detector, or the authors'
+classifier with either border rule. Runnable for the note (all three)::
 
     .venv/bin/python -m tests.sim.hog_testbed [STEP]
 """
@@ -277,10 +278,48 @@ def summary(values: list[float]) -> str:
     )
 
 
-if __name__ == "__main__":
+def authors_scorer(border: str) -> Scorer:
+    """The authors' classifier on the window the detector gives it (``detector.hog: authors``).
+
+    ``border`` is ``detector.hog_border``: ``skip`` gives the thesis' -100 to a window that
+    is not inside the image, ``pad`` scores it with the outside filled black.
+    """
+    from rgbd_eval.detect.authors_hog import PersonWindow, person_confidences
+
+    def score(rgb: NDArray[np.uint8], box: Box2D) -> float:
+        h, w = rgb.shape[:2]
+        inside = box.left >= 0 and box.top >= 0 and box.right <= w and box.bottom <= h
+        if border == "skip" and not inside:
+            return -100.0  # seed 000, 5.4.2: HOG only for clusters visible top to bottom
+        window = PersonWindow(box.height, box.left + box.width / 2, box.top + box.height / 2)
+        return float(person_confidences(rgb, [window])[0])
+
+    return score
+
+
+def opencv_scorer() -> Scorer:
+    """OpenCV's INRIA people detector (``detector.hog: opencv``)."""
     from rgbd_eval.detect.hog import hog_confidence
 
+    return hog_confidence
+
+
+if __name__ == "__main__":
     step = int(sys.argv[1]) if len(sys.argv) > 1 else 6
-    scores = score_all(hog_confidence, step)
-    for cls, values in scores.items():
-        print(f"opencv {cls:22s} {summary(values)}")
+    scorers = {
+        "opencv": opencv_scorer(),
+        "authors/skip": authors_scorer("skip"),
+        "authors/pad": authors_scorer("pad"),
+    }
+    per: dict[str, dict[str, list[float]]] = {name: {} for name in scorers}
+    for cls in CLASSES:
+        for w in windows(cls, step):
+            for name, scorer in scorers.items():
+                per[name].setdefault(w.cls, []).append(scorer(w.rgb, w.box))
+    for name, scores in per.items():
+        for cls, values in scores.items():
+            print(f"{name:12s} {cls:22s} {summary(values)}")
+        people = [v for c, vs in scores.items() if not c.startswith("object:") for v in vs]
+        objects = [v for c, vs in scores.items() if c.startswith("object:") for v in vs]
+        print(f"{name:12s} {'all people':22s} {summary(people)}")
+        print(f"{name:12s} {'all objects':22s} {summary(objects)}")
