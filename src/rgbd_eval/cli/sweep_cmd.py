@@ -30,7 +30,10 @@ def sweep_plot(result: SweepResult, path: Path) -> None:
 
     key = result.params[0]
     pts = result.overall()
-    xs = [float(p[key]) for p, _ in pts]
+    values = [p[key] for p, _ in pts]
+    numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
+    # non-numeric values (null, true/false, names) are plotted at evenly spaced positions
+    xs = [float(v) for v in values] if numeric else [float(i) for i in range(len(values))]
     from rgbd_eval.metrics import summarize
 
     sums = [summarize(c) for _, c in pts]
@@ -38,6 +41,8 @@ def sweep_plot(result: SweepResult, path: Path) -> None:
     for metric, label in _PLOTTED:
         ax.plot(xs, [100 * float(s[metric] or 0.0) for s in sums], "o-", label=f"{label} (%)")
     ax.set_xlabel(key)
+    if not numeric:
+        ax.set_xticks(xs, [str(v).lower() if v is not None else "null" for v in values])
     ax.set_ylabel("%")
     ax2 = ax.twinx()
     ax2.plot(
