@@ -246,7 +246,8 @@ class TrackerConfig(_Model):
         gt=0.0,
         le=600.0,
         description="beyond the thesis, off by default: discard a validated track whose "
-        "detections for this many seconds all scored at or below min_confidence and stayed "
+        "detections for this many seconds all scored below detector.min_confidence (Table 5.1: "
+        "not a person) and stayed "
         "within static_motion_m of their mean (a track held by a coat stand or a mannequin)",
     )
     static_motion_m: float = Field(

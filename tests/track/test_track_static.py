@@ -1,7 +1,8 @@
 """The optional static de-validation of the basso2012 tracker (beyond the thesis, off by default).
 
-Micro-scenarios at 30 Hz with a 1 s window (30 frame periods), ``min_confidence`` -0.5
-and 3 detections to validate (Table 6.1).
+Micro-scenarios at 30 Hz with a 1 s window (30 frame periods), the detector's person
+threshold -1.5 (Table 5.1), track-initialisation threshold -0.5 and 3 detections to
+validate (Table 6.1).
 """
 
 from __future__ import annotations
@@ -43,17 +44,20 @@ def test_default_off_keeps_the_thesis_tracker() -> None:
 def test_a_motionless_unconfident_track_is_discarded_after_the_window() -> None:
     outs = _run(_tracker(static_devalidation_s=1.0), [_object(k, -2.0) for k in range(60)])
     # Confident at frames 0..2, then -2 from frame 3 (t = 0.1 s). The window [t - 1 s, t] holds
-    # only scores <= -0.5 once its start is past frame 2, i.e. t - 1 s >= 3/30 s: frame 33.
+    # only scores < -1.5 once its start is past frame 2, i.e. t - 1 s >= 3/30 s: frame 33.
     assert _validated(outs[32]) == [1]
     assert outs[33] == []
     # no new track: -2 is below min_confidence, so no detection starts one (6.4.1)
     assert all(o == [] for o in outs[33:])
 
 
-def test_one_confident_detection_in_the_window_keeps_the_track() -> None:
-    # a score of 0.0 (> -0.5) every 20 frames (0.67 s < 1 s window): never a whole window below
-    frames = [_object(k, 0.0 if k % 20 == 0 else -2.0) for k in range(90)]
+def test_one_person_like_detection_in_the_window_keeps_the_track() -> None:
+    # a score of -1.5 (not below the person threshold) every 20 frames (0.67 s < 1 s window)
+    frames = [_object(k, -1.5 if k % 20 == 0 else -2.0) for k in range(90)]
     outs = _run(_tracker(static_devalidation_s=1.0), frames)
+    assert all(_validated(o) == [1] for o in outs[2:])
+    # a still person scoring -1.0 (between -1.5 and the tracker's -0.5) keeps the track
+    outs = _run(_tracker(static_devalidation_s=1.0), [_object(k, -1.0) for k in range(90)])
     assert all(_validated(o) == [1] for o in outs[2:])
 
 

@@ -17,11 +17,12 @@ Per frame, in the world frame of odometry (6.5.1):
    kept for ``classifier_memory_s`` (Figure 7.7) for steps 3 and 6, then dropped (6.4.4).
 
 Beyond the thesis, off by default (``static_devalidation_s``): a validated track whose
-detections over that window all scored at or below ``min_confidence`` and stayed within
-``static_motion_m`` of their mean is discarded, as a fake track is. People walk and
-mostly score above the threshold; a coat stand or a mannequin that once got three
-confident detections stays put and scores low. The cost: a person who stands still
-while hidden from HOG (sitting, cut by the image border) loses the track.
+detections over that window all scored below the detector's person threshold
+(``detector.min_confidence``, Table 5.1: -1.5, "not a person") and stayed within
+``static_motion_m`` of their mean is discarded, as a fake track is. People walk or
+score above that threshold; a coat stand or a plant that once got three confident
+detections stays put and scores low. The cost: a person who stands still while
+hidden from HOG (sitting, cut by the image border) loses the track.
 
 Frame counts are turned into seconds at ``reference_rate_hz`` and compared with
 stamp differences, so dropped frames and other rates keep their meaning in time.
@@ -115,6 +116,7 @@ class Basso2012Tracker:
         self._memory_ns = _ns(memory_s)
         static_s = cfg.static_devalidation_s
         self._static_ns = None if static_s is None else _ns(static_s)
+        self._not_person = config.detector.min_confidence  # Table 5.1 ~people/min_confidence
         self._x = np.zeros((0, 4))
         self._P = np.zeros((0, 4, 4))
         self._tracks: list[_Track] = []
@@ -374,7 +376,7 @@ class Basso2012Tracker:
         self._keep(keep)
 
     def _static(self, t: _Track, stamp_ns: int) -> bool:
-        """``static_devalidation_s``: seen, unconfident and motionless for the whole window."""
+        """``static_devalidation_s``: seen, "not a person" and motionless for the whole window."""
         if self._static_ns is None or not t.validated or t.recent is None:
             return False
         recent = t.recent
@@ -383,7 +385,7 @@ class Basso2012Tracker:
             return False
         if len(recent) < self._cfg.detections_to_validate:
             return False
-        if max(r[3] for r in recent) > self._cfg.min_confidence:
+        if max(r[3] for r in recent) >= self._not_person:
             return False
         xy = np.array([(r[1], r[2]) for r in recent])
         spread = float(np.max(np.linalg.norm(xy - xy.mean(axis=0), axis=1)))
