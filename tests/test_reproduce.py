@@ -13,11 +13,13 @@ from rgbd_eval.reproduce import (
     VOXEL_SIZES,
     Reproduction,
     check_claims,
+    miss_counts,
     paper_values,
     render_markdown,
     reproduce_basso2012,
 )
 from rgbd_eval.sim import load_scenario, synthesize
+from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
 
 def row(
@@ -154,6 +156,36 @@ def test_paper_values_file_problems_are_config_errors(tmp_path: Path) -> None:
         paper_values(bad)
 
 
+def test_misses_are_grouped_by_height_and_visibility() -> None:
+    def person(pid: int, left: float, z: float, vis: float) -> GroundTruthObject:
+        return GroundTruthObject(0, 0, pid, Box2D(left, 100, 50, 200), (3.0, 0.0, z), vis)
+
+    def track(tid: int, left: float, status: TrackStatus = TrackStatus.VALIDATED) -> TrackOutput:
+        return TrackOutput(
+            tid, 3.0, 0.0, 1.7, Box2D(left, 100, 50, 200), Visibility.VISIBLE, status
+        )
+
+    frames = [
+        # seated (height 2 x 0.55 = 1.1 m < 1.4 m), not covered; a standing, fully visible
+        # person covered by track 1 (same box: IoU 1)
+        [person(1, 0, 0.55, 1.0), person(2, 200, 0.85, 1.0)],
+        # 30% visible, covered by a box 10 px off: IoU = 40x200 / (2 x 50x200 - 40x200) = 2/3;
+        # 70% visible, only a NEW (unvalidated) track on it: missed
+        [person(2, 200, 0.85, 0.3), person(3, 400, 0.9, 0.7)],
+    ]
+    tracks = [[track(1, 200)], [track(1, 210), track(5, 400, TrackStatus.NEW)]]
+    got = miss_counts(frames, tracks, min_height=1.4)
+    assert got == {
+        "shorter than min_height": {"gt": 1, "missed": 1},
+        "visible < 50%": {"gt": 1, "missed": 0},
+        "visible 50-90%": {"gt": 1, "missed": 1},
+        "visible >= 90%": {"gt": 1, "missed": 0},
+    }
+    # a box 30 px off: IoU = 20x200 / (2 x 50x200 - 20x200) = 0.25 < 0.5 -> missed
+    got = miss_counts(frames[:1], [[track(1, 230)]], min_height=1.4)
+    assert got["visible >= 90%"] == {"gt": 1, "missed": 1}
+
+
 def test_two_scenarios_on_one_file_name_are_refused(tmp_path: Path) -> None:
     one = tmp_path / "a" / "x.mcap"
     other = tmp_path / "b" / "x.mcap"
@@ -185,3 +217,5 @@ def test_small_reproduction_runs(tmp_path: Path) -> None:
     text = render_markdown(res, paper_values())
     assert res.claims and "Table 7.2" in text and "detector + tracker fps" in text
     assert "| static 2 s | static_clutter |" in text
+    assert set(res.misses) == {"moving_obstacles"}
+    assert sum(g["gt"] for g in res.misses["moving_obstacles"].values()) > 0
