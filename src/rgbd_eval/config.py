@@ -141,10 +141,11 @@ class DetectorConfig(_Model):
         "the units of the thesis' confidence thresholds) or 'opencv' (INRIA people detector)",
     )
     hog_border: HogBorder = Field(
-        HogBorder.SKIP,
-        description="'skip': clusters not visible top to bottom get hog_default_confidence "
-        "(the thesis, 5.4.2); 'pad': they are scored with the window's outside filled black "
-        "(the authors' later PCL code)",
+        HogBorder.PAD,
+        description="'pad' (default): every cluster is scored, the window's outside the image "
+        "black (the authors' later PCL code), so people cut by the image or whose feet are "
+        "hidden can start tracks; 'skip': clusters not visible top to bottom get "
+        "hog_default_confidence (the thesis, 5.4.2; what `reproduce basso2012` uses)",
     )
     hog_max_ground_gap: float = Field(
         0.3,

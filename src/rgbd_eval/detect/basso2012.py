@@ -262,10 +262,12 @@ class Basso2012Detector:
             point_label[labelled], signed_heights(np.take(cloud.points, labelled, axis=0), plane), k
         )[1]
         in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
+        # Each cluster's full-resolution points, gathered once for geometry and blob.
+        full = {c: np.take(cloud.points, members(c), axis=0) for c in in_range.tolist()}
         geometries = {
             c: cluster_geometry(
                 np.take(pts, voxels(c), axis=0),
-                np.take(cloud.points, members(c), axis=0),
+                full[c],
                 plane,
                 cfg.head_centroid,
                 cfg.surface_correction,
@@ -307,7 +309,7 @@ class Basso2012Detector:
             # centred on the projected mid point of the person's axis.
             mid_uv, _ = project(g.theoretical_centroid[None, :])
             window = PersonWindow(box.height, float(mid_uv[0, 0]), float(mid_uv[0, 1]))
-            blob_uv, _ = project(np.take(cloud.points, members(c), axis=0))
+            blob_uv, _ = project(full[c])
             appearance = colour_histogram(
                 frame.rgb, blob(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
             )
