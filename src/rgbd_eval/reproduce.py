@@ -607,7 +607,9 @@ def render_markdown(res: Reproduction, paper: Mapping[str, Any]) -> str:
         "# Reproduction of basso2012 (seed 000, chapter 7) on the synthetic scenarios",
         "",
         f"Wall time {res.seconds:.0f} s. Sequences are synthetic stand-ins (configs/scenarios/); "
-        "the thesis' own recordings are not available.",
+        "the thesis' own recordings are not available. Detector as in the thesis: the "
+        "authors' classifier (`detector.hog: authors`), clusters not visible top to bottom "
+        "unscored (`detector.hog_border: skip`, 5.4.2; users' default is `pad`).",
         "",
     ]
     for tab in ("7.2", "7.3"):
