@@ -3,10 +3,11 @@
 //   pcl_people_oracle classify MODEL.yaml IMAGE.ppm WINDOWS.txt
 //       One line per window "height xc yc" (pixels) in WINDOWS.txt: prints
 //       pcl::people::PersonClassifier<pcl::RGB>::evaluate(height, xc, yc, image), %.9f.
-//   pcl_people_oracle detect MODEL.yaml CLOUD.pcd A B C D FX FY CX CY VOXEL REPEAT
+//   pcl_people_oracle detect MODEL.yaml CLOUD.pcd A B C D FX FY CX CY VOXEL REPEAT [RANGE]
 //       Runs GroundBasedPeopleDetectionApp<PointXYZRGBA>::compute on the organised
 //       cloud REPEAT times (ground plane a b c d and intrinsics given; min/max height
-//       1.4/2.3 m, max distance 6.5 m as Table 5.1 of seed 000); prints the CPU
+//       1.4/2.3 m; depth range RANGE m, default 6.5 as Table 5.1 of seed 000, PCL's
+//       own default is 50); prints the CPU
 //       time of each call ("cpu_ms <t>", this thread's CPU clock) and the clusters
 //       of the last call ("person <confidence> <height> <x> <y> <z>").
 //
@@ -76,7 +77,7 @@ int classify(const std::string& model, const std::string& image_path, const std:
   return 0;
 }
 
-int detect(char** argv) {
+int detect(int argc, char** argv) {
   using PointT = pcl::PointXYZRGBA;
   pcl::people::PersonClassifier<pcl::RGB> classifier;
   if (!classifier.loadSVMFromFile(argv[2])) return 2;
@@ -89,6 +90,7 @@ int detect(char** argv) {
       std::stof(argv[11]), 0, 0, 1;
   const float voxel = std::stof(argv[12]);
   const int repeat = std::stoi(argv[13]);
+  const float range = argc > 14 ? std::stof(argv[14]) : 6.5f;
   std::vector<pcl::people::PersonCluster<PointT>> clusters;
   for (int k = 0; k < repeat; ++k) {
     // A fresh app and copy of the cloud per call: compute() modifies both.
@@ -99,7 +101,7 @@ int detect(char** argv) {
     app.setIntrinsics(intrinsics);
     app.setClassifier(classifier);
     app.setPersonClusterLimits(1.4f, 2.3f, 0.1f, 8.0f);
-    app.setFOV(0.0f, 6.5f);
+    app.setFOV(0.0f, range);
     app.setGround(plane);
     app.setInputCloud(cloud);
     clusters.clear();
@@ -120,9 +122,9 @@ int detect(char** argv) {
 int main(int argc, char** argv) {
   const std::string mode = argc > 1 ? argv[1] : "";
   if (mode == "classify" && argc == 5) return classify(argv[2], argv[3], argv[4]);
-  if (mode == "detect" && argc == 14) return detect(argv);
+  if (mode == "detect" && (argc == 14 || argc == 15)) return detect(argc, argv);
   std::cerr << "usage: " << argv[0] << " classify MODEL.yaml IMAGE.ppm WINDOWS.txt\n"
             << "       " << argv[0]
-            << " detect MODEL.yaml CLOUD.pcd A B C D FX FY CX CY VOXEL REPEAT\n";
+            << " detect MODEL.yaml CLOUD.pcd A B C D FX FY CX CY VOXEL REPEAT [RANGE]\n";
   return 2;
 }

@@ -1,7 +1,7 @@
 """On-disk cache of detections, keyed by recording content and detector config.
 
-Detections are a pure function of (recording, io config, method, detector
-config), so a sweep over tracker parameters runs detection once per sequence.
+Detections are a pure function of (recording, io config, detector config: its
+``name`` included), so a sweep over tracker parameters runs detection once per sequence.
 Entries are pickles written atomically; a corrupt or foreign entry is a miss.
 """
 
@@ -18,7 +18,7 @@ from rgbd_eval.config import RunConfig
 from rgbd_eval.pipeline import SequenceDetections
 
 #: Bump when the Detection layout or the detector's behaviour changes incompatibly.
-CACHE_FORMAT = 1
+CACHE_FORMAT = 2
 
 
 def default_cache_dir() -> Path:
@@ -32,7 +32,6 @@ def detection_key(recording_digest: str, config: RunConfig) -> str:
         "format": CACHE_FORMAT,
         "tool": __version__,
         "recording": recording_digest,
-        "method": config.method,
         "io": config.io.model_dump(mode="json"),
         "detector": config.detector.model_dump(mode="json"),
     }

@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import Any
 
 from rgbd_eval.cache import DetectionCache, detection_key
-from rgbd_eval.config import RunConfig, build_config, load_config, load_yaml, repo_root
+from rgbd_eval.config import RunConfig, build_config, config_dir, load_config, load_yaml
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError, InputError
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.methods.basso2012 import CLUTTER, SCENARIOS
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.metrics.gating import iou_matrix
 from rgbd_eval.pipeline import (
@@ -26,6 +27,7 @@ from rgbd_eval.pipeline import (
     detect_sequence,
     ground_truth_file,
     match_ground_truth,
+    open_for,
     sequence_name,
     track_sequence,
 )
@@ -33,19 +35,9 @@ from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
-SCENARIOS = (
-    "static_simple",
-    "static_complex",
-    "static_obstacles",
-    "moving_simple",
-    "moving_complex",
-    "moving_obstacles",
-)
 MEMORY_SECONDS = (0.0, 3.0, 30.0)  # Figure 7.7
 VOXEL_SIZES = (0.04, 0.06, 0.08, 0.10, 0.12, 0.15)  # Figure 7.9
 THRESHOLDS = (0.5, 0.0, -0.5, -1.0, -1.5, -1.75, -2.0, -2.5, -3.0)  # Table 7.6
-#: Beyond the thesis: the obstacle sequences plus person-sized clutter.
-CLUTTER = ("static_clutter", "moving_clutter")
 #: The clutter variant: static de-validation over the thesis' fake-track window
 #: (Table 6.1 frames_before_fake 60 at 30 Hz = 2 s); None is the thesis' tracker.
 STATIC_VARIANT = ("tracker.static_devalidation_s", (None, 2.0))
@@ -62,9 +54,17 @@ PHASES: dict[str, tuple[str, ...]] = {
 Progress = Callable[[str], None]
 
 
+def _detector(config: RunConfig) -> Basso2012DetectorConfig:
+    """The basso2012 detector config of ``config`` (the experiments are the thesis')."""
+    det = config.detector
+    if not isinstance(det, Basso2012DetectorConfig):
+        raise ConfigError(f"reproduce basso2012 needs the basso2012 detector, not {det.name!r}")
+    return det
+
+
 def paper_values(path: Path | None = None) -> dict[str, Any]:
     """The published numbers and claim thresholds (``configs/papers/basso2012.yaml``)."""
-    source = path or repo_root() / "configs" / "papers" / "basso2012.yaml"
+    source = path or config_dir() / "papers" / "basso2012.yaml"
     data = load_yaml(source)
     for key in ("tables", "figures", "claims"):
         if not isinstance(data.get(key), dict):
@@ -132,7 +132,7 @@ def cached_detections(
     key = detection_key(digest, config)
     detections = store.load(key)
     if detections is None:  # not cached (or the file changed since): detect now
-        detections = detect_sequence(open_recording(recording, config.io), config)
+        detections = detect_sequence(open_for(recording, config), config)
         store.store(key, detections)
     return detections
 
@@ -182,7 +182,7 @@ def miss_breakdown(
     detections = cached_detections(config, recording, digest, cache)
     frames = match_ground_truth(gt, detections.stamps_ns, config).frames
     tracks = track_sequence(detections, config)
-    return miss_counts(frames, tracks, config.detector.min_height)
+    return miss_counts(frames, tracks, _detector(config).min_height)
 
 
 def miss_counts(
@@ -226,9 +226,9 @@ def voxel_timing(
     ``max_points`` (Table 5.1: 30 and 600 for 0.06 m) are scaled by (voxel_size / v)^2.
     """
     base_cfg = build_config(base, [])
-    det = base_cfg.detector
+    det = _detector(base_cfg)
     out: dict[float, dict[str, float]] = {}
-    rec = open_recording(recording, base_cfg.io)
+    rec = open_for(recording, base_cfg)
     for v in VOXEL_SIZES:
         scale = (det.voxel_size / v) ** 2
         cfg = build_config(
@@ -239,7 +239,7 @@ def voxel_timing(
                 ("detector.max_points", max(2, round(det.max_points * scale))),
             ],
         )
-        detector = create_detector(cfg.method, cfg)
+        detector = create_detector(cfg)
         sums: dict[str, float] = {}
         n = 0
         start = time.perf_counter()
@@ -337,8 +337,9 @@ def reproduce_basso2012(
     say(f"Figure 7.9 and Table 7.1: detection and tracking time on {timing_seq.stem}")
     res.voxel_timing = voxel_timing(timing_seq, base)
     dets = cached_detections(default_cfg, timing_seq, file_digest(timing_seq), cache)
-    detect_ms = res.voxel_timing[default_cfg.detector.voxel_size]["total_detect"]
-    read_ms = res.voxel_timing[default_cfg.detector.voxel_size]["read"]
+    voxel = _detector(default_cfg).voxel_size
+    detect_ms = res.voxel_timing[voxel]["total_detect"]
+    read_ms = res.voxel_timing[voxel]["read"]
     track_ms = tracking_ms(dets, default_cfg)
     res.frame_rates[f"Table 7.1: {timing_seq.stem}, one core"] = {
         "read_ms": read_ms,

@@ -2,7 +2,9 @@
 
 Work runs in two phases. Phase 1 computes (or loads from the cache) the
 detections of every sequence for every distinct detector config of the grid;
-phase 2 tracks and scores every (sequence, grid point). Both phases run in
+phase 2 tracks and scores every (sequence, grid point). A tracker that reads
+frames (``needs_frame``) gets them by reading the recording again in phase 2;
+the others replay the cached detections alone. Both phases run in
 ``jobs`` processes (inline when ``jobs == 1``). Results are records, never
 parsed from printed text.
 """
@@ -21,18 +23,19 @@ from typing import Any
 from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
 from rgbd_eval.errors import ConfigError, ScoringError
-from rgbd_eval.io.reader import open_recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,
     detect_sequence,
     ground_truth_file,
     match_ground_truth,
+    open_for,
     score_sequence,
     sequence_name,
     track_sequence,
 )
 from rgbd_eval.report import file_digest
+from rgbd_eval.track.protocol import needs_frame
 
 Point = dict[str, Any]
 
@@ -144,7 +147,7 @@ def _detect_job(
     hit = detections is not None
     if detections is None or gt is None:
         # The index pass reads every image message: only when detecting or for a ground-truth topic.
-        recording = open_recording(path, config.io)
+        recording = open_for(path, config)
         if gt is None:
             gt = recording.ground_truth_topic
         if gt is None:
@@ -163,7 +166,9 @@ def _track_job(prepared: _Prepared, config: RunConfig, cache_root: Path) -> tupl
     detections = DetectionCache(cache_root).load(prepared.key)
     if detections is None:
         raise ConfigError(f"detection cache entry {prepared.key} vanished during the sweep")
-    tracks = track_sequence(detections, config)
+    # A tracker that reads frames replays them from the recording, read again.
+    recording = open_for(prepared.path, config) if needs_frame(config) else None
+    tracks = track_sequence(detections, config, recording)
     scores = score_sequence(prepared.ground_truth, tracks, config)
     return scores.counts, time.perf_counter() - start
 

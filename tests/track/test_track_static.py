@@ -7,7 +7,7 @@ validate (Table 6.1).
 
 from __future__ import annotations
 
-from rgbd_eval.config import RunConfig, TrackerConfig
+from rgbd_eval.config import build_config
 from rgbd_eval.track import create_tracker
 from rgbd_eval.track.basso2012 import Basso2012Tracker
 from rgbd_eval.track.synthetic import person_detection
@@ -17,7 +17,7 @@ RATE = 30.0
 
 
 def _tracker(**tracker: object) -> Basso2012Tracker:
-    t = create_tracker("basso2012", RunConfig(tracker=TrackerConfig(**tracker)))
+    t = create_tracker(build_config({"tracker": tracker}))
     assert isinstance(t, Basso2012Tracker)
     return t
 

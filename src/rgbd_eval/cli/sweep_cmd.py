@@ -11,7 +11,13 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import SCHEMA_VERSION, console, handle_errors
+from rgbd_eval.cli.common import (
+    SCHEMA_VERSION,
+    TopicOption,
+    console,
+    handle_errors,
+    topic_overrides,
+)
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError
 
@@ -94,6 +100,7 @@ def sweep(
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    topics: TopicOption = None,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
@@ -112,7 +119,7 @@ def sweep(
 
     specs: list[SweepParam] = [parse_param(p) for p in params or []]
     names = list(dataset or [])
-    fixed = list(overrides or [])
+    fixed = [*(overrides or []), *topic_overrides(topics)]
     if file is not None:
         data = load_yaml(file)
         unknown = set(data) - {"params", "datasets", "set"}

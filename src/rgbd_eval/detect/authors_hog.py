@@ -162,30 +162,39 @@ def _sample_loop(
     img_h, img_w = rgb.shape[0], rgb.shape[1]
     inv_y = one / (np.float32(WINDOW_HEIGHT) / np.float32(height))
     inv_x = one / (np.float32(WINDOW_WIDTH) / np.float32(width))
+    # Per output column: floor/ceiling crop column, weight, whether in the image.
+    k_lo = np.empty(WINDOW_WIDTH, dtype=np.int64)
+    k_hi = np.empty(WINDOW_WIDTH, dtype=np.int64)
+    w2s = np.empty(WINDOW_WIDTH, dtype=np.float32)
+    cols = 0
+    for j in range(WINDOW_WIDTH):
+        b = np.float32(j) * inv_x
+        f2 = math.floor(b)
+        c2 = math.ceil(b)
+        if c2 >= width:
+            break  # and every later column (c2 grows with j)
+        w2s[j] = b - np.float32(f2)
+        k_lo[j], k_hi[j] = xmin + f2, xmin + c2
+        cols = j + 1
+    zero = np.float32(0.0)
     for i in range(WINDOW_HEIGHT):
         a = np.float32(i) * inv_y
         f1 = math.floor(a)
         c1 = math.ceil(a)
         if c1 >= height:
-            continue
+            break  # and every later row
         w1 = a - np.float32(f1)
         r_lo, r_hi = ymin + f1, ymin + c1
         lo_in = 0 <= r_lo < img_h
         hi_in = 0 <= r_hi < img_h
-        for j in range(WINDOW_WIDTH):
-            b = np.float32(j) * inv_x
-            f2 = math.floor(b)
-            c2 = math.ceil(b)
-            if c2 >= width:
-                continue
-            w2 = b - np.float32(f2)
-            k_lo, k_hi = xmin + f2, xmin + c2
-            lo_c = 0 <= k_lo < img_w
-            hi_c = 0 <= k_hi < img_w
+        for j in range(cols):
+            w2 = w2s[j]
+            lo_c = 0 <= k_lo[j] < img_w
+            hi_c = 0 <= k_hi[j] < img_w
             for ch in range(3):
-                g1 = np.float32(rgb[r_hi, k_lo, ch]) if hi_in and lo_c else np.float32(0.0)
-                g3 = np.float32(rgb[r_lo, k_lo, ch]) if lo_in and lo_c else np.float32(0.0)
-                g4 = np.float32(rgb[r_lo, k_hi, ch]) if lo_in and hi_c else np.float32(0.0)
+                g1 = np.float32(rgb[r_hi, k_lo[j], ch]) if hi_in and lo_c else zero
+                g3 = np.float32(rgb[r_lo, k_lo[j], ch]) if lo_in and lo_c else zero
+                g4 = np.float32(rgb[r_lo, k_hi[j], ch]) if lo_in and hi_c else zero
                 v = (one - w1) * ((one - w2) * g1 + w2 * g4) + w1 * ((one - w2) * g3 + w2 * g4)
                 out[i, j, ch] = np.float32(int(v)) / np.float32(255.0)
 
@@ -280,8 +289,8 @@ def _acos_table() -> Float32Array:
 def _histogram_loop(
     img: Float32Array,
     table: Float32Array,
-    rsqrt: Float32Array,
-    rcp: Float32Array,
+    rsqrt: NDArray[np.uint32],
+    rcp: NDArray[np.uint32],
     approximate: bool,
     hist: Float32Array,
 ) -> None:
@@ -295,7 +304,8 @@ def _histogram_loop(
     four nearest cell centres (cell ``k`` centred at pixel ``8k + 3.5``). Pixel order
     and float32 arithmetic are the C++'s, so sums round the same way. With
     ``approximate``, ``1 / sqrt(m^2)`` and ``m = 1 / that`` come from the SSE tables
-    ``rsqrt``/``rcp`` (as :func:`sse_rsqrt`, :func:`sse_rcp`); else they are exact.
+    ``rsqrt``/``rcp`` (their float32 bits; as :func:`sse_rsqrt`, :func:`sse_rcp`);
+    else they are exact.
     """
     half = np.float32(0.5)
     one = np.float32(1.0)
@@ -308,6 +318,8 @@ def _histogram_loop(
     init = (zero + half) * s_inv - half
     centre = _ACOS_ENTRIES // 2
     flt_min = np.float32(_FLT_MIN)
+    buf = np.empty(1, dtype=np.float32)
+    bits = buf.view(np.uint32)
     h, w = WINDOW_HEIGHT, WINDOW_WIDTH
     hb, wb = _CELLS_Y, _CELLS_X
     xb = init
@@ -333,16 +345,23 @@ def _histogram_loop(
                 if c == 0 or m2 > m2_best:
                     gx_best, gy_best, m2_best = gx, gy, m2
             if approximate:
+                # Table entry for the mantissa's top 12 bits, its exponent field shifted
+                # by the input's (halved, for rsqrt): exact powers of two.
                 if m2_best >= flt_min:
-                    frac, e2 = math.frexp(m2_best)  # m2 = (2 frac) 2^(e2 - 1)
-                    odd = (e2 - 1) & 1
-                    k = int((np.float64(frac) * 2.0 - 1.0) * 4096.0)
-                    inv = min(np.float32(math.ldexp(rsqrt[odd, k], -((e2 - 1 - odd) // 2))), cap)
+                    buf[0] = m2_best
+                    b = np.int64(bits[0])
+                    e = ((b >> 23) & 0xFF) - 127
+                    odd = e & 1
+                    r = np.int64(rsqrt[odd, (b >> 11) & 0xFFF]) - (((e - odd) // 2) << 23)
+                    bits[0] = np.uint32(r)
+                    inv = min(buf[0], cap)
                 else:
                     inv = cap
-                frac, e2 = math.frexp(inv)
-                k = int((np.float64(frac) * 2.0 - 1.0) * 4096.0)
-                mag = np.float32(math.ldexp(rcp[k], -(e2 - 1)))
+                buf[0] = inv
+                b = np.int64(bits[0])
+                e = ((b >> 23) & 0xFF) - 127
+                bits[0] = np.uint32(np.int64(rcp[(b >> 11) & 0xFFF]) - (e << 23))
+                mag = buf[0]
             else:
                 inv = min(one / np.float32(math.sqrt(m2_best)), cap) if m2_best > zero else cap
                 mag = one / inv
@@ -364,21 +383,21 @@ def _histogram_loop(
             w01 = yd - xyd  # (xb0, yb0 + 1)
             w10 = xd - xyd  # (xb0 + 1, yb0)
             w11 = xyd  # (xb0 + 1, yb0 + 1)
-            for b, mb in ((bin0, m0), (bin1, m1)):
+            for ob, mb in ((bin0, m0), (bin1, m1)):
                 if has_lf:
                     if yb0 >= 0:
-                        hist[b, xb0, yb0] += w00 * mb
+                        hist[ob, xb0, yb0] += w00 * mb
                     if yb0 + 1 < hb:
-                        hist[b, xb0, yb0 + 1] += w01 * mb
+                        hist[ob, xb0, yb0 + 1] += w01 * mb
                 if has_rt:
                     if yb0 >= 0:
-                        hist[b, xb0 + 1, yb0] += w10 * mb
+                        hist[ob, xb0 + 1, yb0] += w10 * mb
                     if yb0 + 1 < hb:
-                        hist[b, xb0 + 1, yb0 + 1] += w11 * mb
+                        hist[ob, xb0 + 1, yb0 + 1] += w11 * mb
 
 
 _histogram_kernel: Callable[
-    [Float32Array, Float32Array, Float32Array, Float32Array, bool, Float32Array], None
+    [Float32Array, Float32Array, NDArray[np.uint32], NDArray[np.uint32], bool, Float32Array], None
 ] = numba.njit(cache=True)(_histogram_loop)
 
 
@@ -413,7 +432,7 @@ def hog_descriptors(samples: Float32Array, approximate: bool = True) -> Float32A
     if samples.ndim != 4 or samples.shape[1:] != (WINDOW_HEIGHT, WINDOW_WIDTH, 3):
         raise ValueError(f"samples must be (N, 128, 64, 3), got {samples.shape}")
     table = _acos_table()
-    rsqrt, rcp = _sse_tables()
+    rsqrt, rcp = (t.view(np.uint32) for t in _sse_tables())
     hist = np.zeros((samples.shape[0], ORIENTATIONS, _CELLS_X, _CELLS_Y), dtype=np.float32)
     for k in range(samples.shape[0]):
         sample = np.ascontiguousarray(samples[k], dtype=np.float32)

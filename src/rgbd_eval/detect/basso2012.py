@@ -22,8 +22,8 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import DetectorConfig, HogBorder, HogClassifier, RunConfig
 from rgbd_eval.detect.authors_hog import PersonWindow, person_confidences
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig, HogBorder, HogClassifier
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -49,11 +49,12 @@ from rgbd_eval.detect.features import (
     full_body_box,
     occluded_by_nearer_points,
     project_to_rgb,
+    touches_border,
 )
 from rgbd_eval.detect.ground import GroundPlaneEstimator
 from rgbd_eval.detect.hog import hog_confidences
 from rgbd_eval.detect.plane import signed_heights
-from rgbd_eval.detect.protocol import Detector, register_detector
+from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Box2D, Box3D, CameraModel, Detection, Frame
 
 FloatArray = NDArray[np.float64]
@@ -98,9 +99,11 @@ class _Candidate:
 class Basso2012Detector:
     """The reference detector of seed 000 (chapter 5), with head-based sub-clustering."""
 
-    def __init__(self, config: DetectorConfig) -> None:
-        if not isinstance(config, DetectorConfig):
-            raise TypeError(f"config must be a DetectorConfig, got {type(config).__name__}")
+    def __init__(self, config: Basso2012DetectorConfig) -> None:
+        if not isinstance(config, Basso2012DetectorConfig):
+            raise TypeError(
+                f"config must be a Basso2012DetectorConfig, got {type(config).__name__}"
+            )
         self.config = config
         self.ground = GroundPlaneEstimator(config)
         self.last_timings: dict[str, float] = dict.fromkeys(STAGES, 0.0)
@@ -283,7 +286,7 @@ class Basso2012Detector:
             box = full_body_box(g, np.take(uv, mine, axis=0), project)
             if box is None:
                 continue
-            cut_top, cut_bottom, cut_side = _touches_border(
+            cut_top, cut_bottom, cut_side = touches_border(
                 cloud.pixels[members(c)], frame.depth_camera
             )
             in_view = box_inside_image(box, frame.rgb_camera) and not (
@@ -350,18 +353,6 @@ def _footprint(frame: Frame) -> int:
     return max(1, round(frame.rgb_camera.fx / frame.depth_camera.fx))
 
 
-def _touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
-    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
-    if pixels.shape[0] == 0:
-        return (False, False, False)
-    rows, cols = np.divmod(pixels, camera.width)
-    return (
-        bool(rows.min() == 0),
-        bool(rows.max() == camera.height - 1),
-        bool(cols.min() == 0 or cols.max() == camera.width - 1),
-    )
-
-
 def _world_box(frame: Frame, points: FloatArray) -> Box3D:
     world = frame.camera_pose.transform_points(points)
     lo, hi = world.min(axis=0), world.max(axis=0)
@@ -384,7 +375,25 @@ def _check_frame(frame: Frame) -> None:
         )
 
 
-@register_detector("basso2012")
-def create_basso2012(config: RunConfig) -> Detector:
-    """Registry factory: the basso2012 detector from ``config.detector``."""
-    return Basso2012Detector(config.detector)
+def _contract(config: Basso2012DetectorConfig) -> DetectionContract:
+    """Ground positions quantised by the voxel grid, RGB boxes, a 3D colour histogram (6.2.2)."""
+    return DetectionContract(
+        world_position=True,
+        box2d=True,
+        appearance="rgb_histogram",
+        appearance_size=config.histogram_bins**3,
+        position_resolution_m=config.voxel_size,
+    )
+
+
+SPEC = register_detector(
+    DetectorSpec(
+        name="basso2012",
+        config_model=Basso2012DetectorConfig,
+        factory=Basso2012Detector,
+        streams=(StreamSpec("colour"), StreamSpec("depth")),
+        contract=_contract,
+        stages=STAGES,
+        summary="voxel grid, ground plane, clusters + head sub-clustering, HOG (seed 000, ch. 5)",
+    )
+)
