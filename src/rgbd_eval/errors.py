@@ -14,6 +14,7 @@ Exit codes (also in README.md):
 4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
+7     an output could not be written (e.g. no MP4 encoder for ``--video``)
 ====  =====================================================================
 """
 
@@ -82,3 +83,13 @@ class CompareInputError(RgbdEvalError):
     """Reports given to ``compare`` cannot be compared."""
 
     exit_code = 2
+
+
+class OutputError(RgbdEvalError):
+    """An output file could not be written."""
+
+    exit_code = 7
+
+    def __init__(self, path: Path | str, message: str) -> None:
+        self.path = Path(path)
+        super().__init__(f"{self.path}: {message}")

@@ -6,7 +6,7 @@ import csv
 import io
 import time
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any
+from typing import Annotated, Any
 
 import typer
 from rich.table import Table
@@ -20,49 +20,6 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError
-
-if TYPE_CHECKING:
-    from rgbd_eval.sweep import SweepResult
-
-_PLOTTED = (("mota", "MOTA"), ("fp_rate", "FP"), ("fn_rate", "FN"))
-
-
-def sweep_plot(result: SweepResult, path: Path) -> None:
-    """MOTA, FP, FN (%) and ID switches against the swept value (seed 000, Figure 7.10)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    key = result.params[0]
-    pts = result.overall()
-    values = [p[key] for p, _ in pts]
-    numeric = all(isinstance(v, int | float) and not isinstance(v, bool) for v in values)
-    # non-numeric values (null, true/false, names) are plotted at evenly spaced positions
-    xs = [float(v) for v in values] if numeric else [float(i) for i in range(len(values))]
-    from rgbd_eval.metrics import summarize
-
-    sums = [summarize(c) for _, c in pts]
-    fig, ax = plt.subplots(figsize=(7, 4.5), dpi=100)
-    for metric, label in _PLOTTED:
-        ax.plot(xs, [100 * float(s[metric] or 0.0) for s in sums], "o-", label=f"{label} (%)")
-    ax.set_xlabel(key)
-    if not numeric:
-        ax.set_xticks(xs, [str(v).lower() if v is not None else "null" for v in values])
-    ax.set_ylabel("%")
-    ax2 = ax.twinx()
-    ax2.plot(
-        xs, [int(s["id_switches"] or 0) for s in sums], "s--", color="tab:red", label="ID switches"
-    )
-    ax2.set_ylabel("ID switches")
-    lines = ax.get_legend_handles_labels()
-    lines2 = ax2.get_legend_handles_labels()
-    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="center right", fontsize=8)
-    ax.grid(True, alpha=0.3)
-    ax.set_title("sweep (all sequences summed)")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
 
 
 def _csv(rows: list[dict[str, Any]]) -> str:
@@ -108,6 +65,7 @@ def sweep(
     from rgbd_eval.config import load_config
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
+    from rgbd_eval.report_html import write_sweep_html
     from rgbd_eval.sweep import (
         SweepParam,
         default_jobs,
@@ -174,9 +132,8 @@ def sweep(
             "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
         },
     )
-    if len(result.params) == 1:
-        sweep_plot(result, out_dir / "sweep.png")
     g = configs[0].evaluation.gating if configs else Gating.IOU
+    write_sweep_html(out_dir, result, method, [str(p) for p in recordings], fixed, g)
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:
@@ -199,5 +156,6 @@ def sweep(
     console.print(table)
     console.print(
         f"wall {wall:.1f} s (detect {result.detect_seconds:.1f} s, track+score {result.track_seconds:.1f} s); "
-        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
+        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); "
+        f"records: {out_dir / 'sweep.csv'}, page: {out_dir / 'sweep.html'}"
     )

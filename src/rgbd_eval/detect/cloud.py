@@ -95,7 +95,8 @@ def voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
     cells, lo_hi = _cells_kernel(points, float(voxel_size))
     lo = [int(v) for v in lo_hi[0]]
     dims = [int(lo_hi[1, k]) - lo[k] + 1 for k in range(3)]
-    if dims[0] * dims[1] * dims[2] <= DENSE_VOXEL_KEYS:
+    key_count = dims[0] * dims[1] * dims[2]
+    if key_count <= min(DENSE_VOXEL_KEYS, DENSE_CELLS_PER_POINT * n):
         # Compiled passes over a table of every cell of the bounding box.
         centroids, point_voxel, counts = _dense_kernel(points, cells, lo_hi[0], np.array(dims))
         return VoxelGrid(centroids=centroids, point_voxel=point_voxel, counts=counts)
@@ -118,9 +119,12 @@ def voxel_grid(points: FloatArray, voxel_size: float) -> VoxelGrid:
     return VoxelGrid(centroids=centroids, point_voxel=point_voxel, counts=counts)
 
 
-#: Largest bounding box (in cells) voxelised through a dense table (8 bytes a cell):
+#: Largest bounding box (in cells) voxelised through a dense table (4 bytes a cell):
 #: a 640x480 frame to 6.5 m at 0.06 m spans about 1.2 million.
 DENSE_VOXEL_KEYS = 1 << 23
+#: ... and only while the table is at most this many cells per point: a 160x120
+#: frame (19200 points) over the same box sorts faster than it fills the table.
+DENSE_CELLS_PER_POINT = 16
 
 
 def _voxel_cells(points: FloatArray, voxel_size: float) -> tuple[IntArray, IntArray]:
@@ -213,13 +217,13 @@ COUNTING_SORT_KEYS = 1 << 20
 def stable_argsort(keys: IntArray, key_count: int) -> IntArray:
     """``np.argsort(keys, kind="stable")`` for keys in ``[0, key_count)``.
 
-    Up to :data:`COUNTING_SORT_KEYS` keys: a compiled counting sort, linear in the
-    number of keys. Otherwise small keys are sorted with their index packed in the
+    Up to :data:`COUNTING_SORT_KEYS` keys, and at most about four per element: a
+    compiled counting sort, linear in elements plus keys. Otherwise small keys are sorted with their index packed in the
     low 32 bits: a plain (SIMD) sort of the packed values gives the stable order,
     two to three times faster than the stable argsort.
     """
     n = keys.shape[0]
-    if key_count <= COUNTING_SORT_KEYS:
+    if key_count <= COUNTING_SORT_KEYS and key_count <= 4 * n + 1024:
         return _counting_kernel(np.ascontiguousarray(keys, dtype=np.int64), int(key_count))
     if key_count > 2**31 or n > 2**32:
         return np.argsort(keys, kind="stable")
