@@ -69,7 +69,7 @@ def test_sweep_points_equal_separate_runs(tmp_path: Path) -> None:
     base = load_config(method="basso2012").model_dump(mode="json")
     grid = expand_grid([SweepParam("tracker.min_confidence", (-1.0, 0.5))])
     configs = point_configs(base, [], grid)
-    result = run_sweep([rec], grid, configs, cache_root=tmp_path / "cache", jobs=2)
+    result = run_sweep([rec], grid, configs, cache_root=tmp_path / "cache")
     for record, config in zip(result.records, configs, strict=True):
         single = run_sequence(rec, config)
         assert single.scores is not None
@@ -87,6 +87,7 @@ def test_cli_takes_negative_values_as_values(tmp_path: Path) -> None:
     rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=4))
     args = ["sweep", "tracker.min_confidence", "-3", "-2.5", "0.5", "--dataset", str(rec)]
     args += ["--cache", str(tmp_path / "cache"), "--out", str(tmp_path / "out")]
+    args += ["--cluster", "local:1"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]

@@ -11,9 +11,10 @@ Exit codes (also in README.md):
 1     ``compare``: a metric regressed beyond its tolerance
 2     command-line usage error; ``compare``: unusable reports
 3     bad input recording (missing, truncated, wrong content)
-4     bad configuration (unknown key, wrong type, value out of range)
+4     bad configuration (unknown key, wrong type, value out of range, unusable cache folder)
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
+7     the Dask cluster cannot be reached, or a task killed every worker it ran on
 ====  =====================================================================
 """
 
@@ -62,6 +63,10 @@ class ConfigError(RgbdEvalError):
     exit_code = 4
 
 
+class CacheError(ConfigError):
+    """The detection cache folder cannot be used (a file, not writable)."""
+
+
 class GroundTruthError(RgbdEvalError):
     """Ground truth is missing, unreadable or contradictory."""
 
@@ -82,3 +87,17 @@ class CompareInputError(RgbdEvalError):
     """Reports given to ``compare`` cannot be compared."""
 
     exit_code = 2
+
+
+class ClusterError(RgbdEvalError):
+    """The Dask scheduler cannot be reached, or a task lost every worker that ran it."""
+
+    exit_code = 7
+
+
+class TaskError(RgbdEvalError):
+    """Tasks of a sweep failed; the exit code is that of the first failure in grid order."""
+
+    def __init__(self, message: str, exit_code: int) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code

@@ -83,7 +83,7 @@ def test_folder_of_recordings_gives_overall_row(tmp_path: Path) -> None:
     write_recording(data / "a.mcap", "mcap", Spec(n=2))
     write_recording(data / "b.bag", "ros1", Spec(n=3))
     out = tmp_path / "out"
-    result = runner.invoke(app, ["run", str(data), "--out", str(out)])
+    result = runner.invoke(app, ["run", str(data), "--out", str(out), "--cluster", "local:1"])
     assert result.exit_code == 0, result.output
     report = json.loads((out / "report.json").read_text())
     assert [s["name"] for s in report["sequences"]] == ["a", "b"]

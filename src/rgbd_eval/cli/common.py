@@ -5,7 +5,7 @@ from __future__ import annotations
 import functools
 import sys
 from collections.abc import Callable
-from typing import Any, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -18,7 +18,10 @@ from rich.progress import (
     TimeRemainingColumn,
 )
 
-from rgbd_eval.errors import RgbdEvalError
+from rgbd_eval.errors import ConfigError, RgbdEvalError
+
+if TYPE_CHECKING:
+    from rgbd_eval.sweep import CacheMode
 
 P = ParamSpec("P")
 R = TypeVar("R")
@@ -28,6 +31,24 @@ console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
 err_console = Console(stderr=True, highlight=False)
 
 SCHEMA_VERSION = 1
+
+CLUSTER_HELP = (
+    "where tasks run: local (one worker per usable CPU), local:N, or tcp://scheduler:8786"
+)
+CACHE_MODE_HELP = (
+    "shared: workers use the cache folder (same path everywhere); "
+    "client: only this process does (workers share no disk)"
+)
+
+
+def parse_cache_mode(text: str) -> CacheMode:
+    """``--cache-mode`` value -> CacheMode."""
+    from rgbd_eval.sweep import CacheMode
+
+    try:
+        return CacheMode(text)
+    except ValueError:
+        raise ConfigError(f"--cache-mode {text!r}: expected shared or client") from None
 
 
 def progress_bar() -> Progress:

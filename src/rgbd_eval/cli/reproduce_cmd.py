@@ -8,7 +8,7 @@ from typing import Annotated
 
 import typer
 
-from rgbd_eval.cli.common import console, err_console, handle_errors
+from rgbd_eval.cli.common import CLUSTER_HELP, console, err_console, handle_errors
 from rgbd_eval.errors import ConfigError
 
 
@@ -18,9 +18,7 @@ def reproduce(
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/reproduce-<time>)")
     ] = None,
-    jobs: Annotated[
-        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
-    ] = None,
+    cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
 ) -> None:
     """Redo the thesis' experiments on the six synthetic scenarios (generated if absent)."""
@@ -28,6 +26,7 @@ def reproduce(
         raise ConfigError(f"reproduce {system!r}: only basso2012 is available")
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.datasets import scenarios_dir
+    from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.reproduce import (
         SCENARIOS,
         paper_values,
@@ -36,7 +35,6 @@ def reproduce(
         to_json,
     )
     from rgbd_eval.sim import dataset_path, load_scenario, synthesize
-    from rgbd_eval.sweep import default_jobs
 
     recordings = {}
     for name in SCENARIOS:
@@ -46,12 +44,10 @@ def reproduce(
             synthesize(load_scenario(scenarios_dir() / f"{name}.yaml"), path)
         recordings[name] = path
     out_dir = out or Path("runs") / f"reproduce-{time.strftime('%Y%m%d-%H%M%S')}"
-    res = reproduce_basso2012(
-        recordings,
-        jobs=jobs if jobs is not None else default_jobs(),
-        cache=cache,
-        progress=lambda m: err_console.print(m),
-    )
+    with connect(parse_cluster(cluster)) as client:
+        res = reproduce_basso2012(
+            recordings, client=client, cache=cache, progress=lambda m: err_console.print(m)
+        )
     text = render_markdown(res, paper_values())
     write_text(out_dir / "reproduce.md", text)
     write_json(out_dir / "reproduce.json", to_json(res))

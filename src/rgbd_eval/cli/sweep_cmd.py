@@ -11,9 +11,18 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import SCHEMA_VERSION, console, handle_errors
+from rgbd_eval.cli.common import (
+    CACHE_MODE_HELP,
+    CLUSTER_HELP,
+    SCHEMA_VERSION,
+    console,
+    err_console,
+    handle_errors,
+    parse_cache_mode,
+    progress_bar,
+)
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.errors import ConfigError, TaskError
 
 if TYPE_CHECKING:
     from rgbd_eval.sweep import SweepResult
@@ -55,6 +64,8 @@ def sweep_plot(result: SweepResult, path: Path) -> None:
 
 
 def _csv(rows: list[dict[str, Any]]) -> str:
+    if not rows:
+        return ""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
     writer.writeheader()
@@ -82,23 +93,22 @@ def sweep(
         list[str] | None, typer.Option("--set", help="fixed KEY=VALUE override")
     ] = None,
     gating: Annotated[str | None, typer.Option(help="'iou' or 'metric'")] = None,
-    jobs: Annotated[
-        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
-    ] = None,
+    cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    cache_mode: Annotated[str, typer.Option(help=CACHE_MODE_HELP)] = "shared",
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.config import load_config
+    from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
     from rgbd_eval.sweep import (
         SweepParam,
-        default_jobs,
         expand_grid,
         parse_param,
         point_configs,
@@ -137,11 +147,24 @@ def sweep(
     configs = point_configs(base, parse_overrides(fixed), grid)
     recordings = [datasets.resolve(n) for n in (names or ["demo"])]
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
-    jobs = jobs if jobs is not None else default_jobs()
-    console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
+    mode = parse_cache_mode(cache_mode)
+    spec = parse_cluster(cluster, tasks=len(grid) * len(recordings))
+    console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
     start = time.perf_counter()
-    result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
+    with connect(spec) as client, progress_bar() as bar:
+        tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
+        result = run_sweep(
+            recordings,
+            grid,
+            configs,
+            client,
+            cache_root=cache,
+            cache_mode=mode,
+            progress=lambda stage, done, n: bar.update(tasks[stage], completed=done, total=n),
+        )
     wall = time.perf_counter() - start
+    for warning in result.warnings:
+        err_console.print(f"warning: {warning}", markup=False, highlight=False)
     rows = result.rows()
     out_dir.mkdir(parents=True, exist_ok=True)
     write_text(out_dir / "sweep.csv", _csv(rows))
@@ -154,15 +177,24 @@ def sweep(
             "datasets": [str(p) for p in recordings],
             "fixed": fixed,
             "records": rows,
+            "failures": [
+                {**f.point, "sequence": f.sequence, "error": f.error, "exit_code": f.exit_code}
+                for f in result.failures
+            ],
+            "cluster": spec.describe(),
             "seconds": {
                 "wall": wall,
-                "detect": result.detect_seconds,
-                "track_score": result.track_seconds,
+                "detect_tasks": result.detect_seconds,
+                "track_score_tasks": result.track_seconds,
             },
-            "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
+            "cache": {
+                "hits": result.cache_hits,
+                "misses": result.cache_misses,
+                "rejected": list(result.warnings),
+            },
         },
     )
-    if len(result.params) == 1:
+    if len(result.params) == 1 and result.records:
         sweep_plot(result, out_dir / "sweep.png")
     g = configs[0].evaluation.gating if configs else Gating.IOU
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
@@ -186,6 +218,17 @@ def sweep(
         table.add_row(*[str(point[p]) for p in result.params], *cells)
     console.print(table)
     console.print(
-        f"wall {wall:.1f} s (detect {result.detect_seconds:.1f} s, track+score {result.track_seconds:.1f} s); "
-        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
+        f"wall {wall:.1f} s (task seconds: detect {result.detect_seconds:.1f}, "
+        f"track+score {result.track_seconds:.1f}); detection cache: {result.cache_hits} hit(s), "
+        f"{result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
     )
+    if result.failures:
+        for f in result.failures:
+            label = ", ".join(f"{k}={v}" for k, v in f.point.items())
+            err_console.print(f"failed: {label} on {f.sequence}: {f.error}", markup=False)
+        n = len(result.failures)
+        units = n + len(result.records)
+        raise TaskError(
+            f"{n} of {units} sweep point(s) failed (listed above and in {out_dir / 'sweep.json'})",
+            result.failures[0].exit_code,
+        )
