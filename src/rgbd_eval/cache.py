@@ -51,16 +51,21 @@ def default_cache_dir() -> Path:
     return Path(os.environ.get("RGBD_EVAL_CACHE", ".cache/rgbd-eval"))
 
 
-def detection_key(recording_digest: str, config: RunConfig) -> str:
-    """The cache key: what the detections depend on, and nothing else."""
+def detector_inputs(config: RunConfig) -> str:
+    """What detections depend on besides the recording, as canonical JSON."""
     payload = {
         "format": CACHE_FORMAT,
         "tool": __version__,
-        "recording": recording_digest,
         "method": config.method,
         "io": config.io.model_dump(mode="json"),
         "detector": config.detector.model_dump(mode="json"),
     }
+    return json.dumps(payload, sort_keys=True)
+
+
+def detection_key(recording_digest: str, config: RunConfig) -> str:
+    """The cache key: what the detections depend on, and nothing else."""
+    payload = {**json.loads(detector_inputs(config)), "recording": recording_digest}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 

@@ -74,21 +74,24 @@ def parse_cluster(spec: str | None, tasks: int | None = None) -> ClusterSpec:
 
 
 @contextmanager
-def connect(spec: ClusterSpec) -> Iterator[Client]:
-    """A client of the cluster ``spec``; a local cluster is started and shut down with it."""
+def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator[Client]:
+    """A client of the cluster ``spec``; a local cluster is started and shut down with it.
+
+    A remote scheduler must answer, and have a worker, within ``timeout_s``.
+    """
     from distributed import Client, LocalCluster
 
     if spec.address is not None:
         try:
-            client = Client(spec.address, timeout=CONNECT_TIMEOUT_S, set_as_default=False)
+            client = Client(spec.address, timeout=timeout_s, set_as_default=False)
         except (OSError, TimeoutError) as err:
             raise ClusterError(f"cannot reach the scheduler at {spec.address}: {err}") from err
         try:
-            client.wait_for_workers(1, timeout=CONNECT_TIMEOUT_S)
+            client.wait_for_workers(1, timeout=timeout_s)
         except (OSError, TimeoutError) as err:
             client.close()
             raise ClusterError(
-                f"the scheduler at {spec.address} has no worker after {CONNECT_TIMEOUT_S:.0f} s"
+                f"the scheduler at {spec.address} has no worker after {timeout_s:g} s"
             ) from err
         with client:
             yield client

@@ -30,10 +30,17 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rgbd_eval.cache import CacheWarning, DetectionCache, decode, detection_key, encode
+from rgbd_eval.cache import (
+    CacheWarning,
+    DetectionCache,
+    decode,
+    detection_key,
+    detector_inputs,
+    encode,
+)
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
 from rgbd_eval.engine import ClusterSpec, connect, killed_worker_message
-from rgbd_eval.errors import ClusterError, ConfigError, RgbdEvalError, ScoringError
+from rgbd_eval.errors import ClusterError, ConfigError, InputError, RgbdEvalError, ScoringError
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
@@ -196,16 +203,22 @@ class _Brief:
 
 def _prepare(
     path: Path,
-    digest: str,
+    digest: str | None,
     config: RunConfig,
     gt_path: Path | None,
     cache_root: Path | None,
     cached: SequenceDetections | None,
 ) -> _Prepared | _Failed:
-    """Detections (cache, ``cached`` from the client, or fresh) and aligned ground truth."""
+    """Detections (cache, ``cached`` from the client, or fresh) and aligned ground truth.
+
+    ``digest`` is the recording's :func:`file_digest`, computed here when None.
+    """
     start = time.perf_counter()
-    key = detection_key(digest, config)
     try:
+        try:
+            key = detection_key(digest or file_digest(path), config)
+        except OSError as err:
+            raise InputError(path, f"cannot read ({err.strerror or err})") from err
         cache = DetectionCache(cache_root) if cache_root is not None else None
         detections = cached
         with warnings.catch_warnings(record=True) as caught:
@@ -289,58 +302,63 @@ def run_sweep(
 
     cache = DetectionCache(cache_root)
     root = cache.root.resolve()  # workers may not share the client's working directory
-    digests = {p: file_digest(p) for p in recordings}
-    # Prepare tasks: one per (recording, distinct detector config).
-    jobs: dict[tuple[Path, str], RunConfig] = {}
-    for config in configs:
-        for path in recordings:
-            jobs.setdefault((path, detection_key(digests[path], config)), config)
-    prepared: dict[tuple[Path, str], Future[Any]] = {}
-    rejected: list[str] = []
-    for (path, key), cfg in jobs.items():
-        cached = None
-        if cache_mode is CacheMode.CLIENT:
-            with warnings.catch_warnings(record=True) as caught:
-                warnings.simplefilter("always", CacheWarning)
-                cached = cache.load(key)
-            rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
-        prepared[(path, key)] = client.submit(
-            _prepare,
-            path.resolve(),
-            digests[path],
-            cfg,
-            gt_path.resolve() if gt_path is not None else None,
-            root if cache_mode is CacheMode.SHARED else None,
-            client.scatter(cached) if cached is not None else None,
-            pure=False,
-        )
-    briefs = {k: client.submit(_brief, f, pure=False) for k, f in prepared.items()}
-    # Track tasks: one per (grid point, recording), started as soon as their detections exist.
+    client_side = cache_mode is CacheMode.CLIENT
+    # The client hashes the recordings only when it reads the cache itself; otherwise each
+    # prepare task hashes its recording on a worker, in parallel.
+    digests = {p: file_digest(p) for p in recordings} if client_side else {}
     units = [
         (point, cfg, path) for point, cfg in zip(grid, configs, strict=True) for path in recordings
     ]
-    tracked = [
-        client.submit(_track, prepared[(path, detection_key(digests[path], cfg))], cfg, pure=False)
-        for _, cfg, path in units
-    ]
-    stage = {f.key: "detect" for f in briefs.values()} | {f.key: "track+score" for f in tracked}
+    # One prepare task per (recording, distinct detector inputs), the track tasks that use it
+    # submitted right after it: the scheduler runs earlier submissions first, so a
+    # recording's detections are tracked, then released, before many more are loaded.
+    groups: dict[tuple[Path, str], list[int]] = {}
+    for i, (_, cfg, path) in enumerate(units):
+        groups.setdefault((path, detector_inputs(cfg)), []).append(i)
+    prepared: dict[tuple[Path, str], Future[Any]] = {}
+    briefs: dict[tuple[Path, str], Future[Any]] = {}
+    tracked: dict[int, Future[Any]] = {}
+    rejected: list[str] = []
+    for group, members in groups.items():
+        path, cfg = group[0], units[members[0]][1]
+        cached = None
+        if client_side:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", CacheWarning)
+                cached = cache.load(detection_key(digests[path], cfg))
+            rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
+        prepared[group] = client.submit(
+            _prepare,
+            path.resolve(),
+            digests.get(path),
+            cfg,
+            gt_path.resolve() if gt_path is not None else None,
+            None if client_side else root,
+            client.scatter(cached) if cached is not None else None,
+            pure=False,
+        )
+        briefs[group] = client.submit(_brief, prepared[group], pure=False)
+        for i in members:
+            tracked[i] = client.submit(_track, prepared[group], units[i][1], pure=False)
+    stage = {f.key: "detect" for f in briefs.values()}
+    stage |= {f.key: "track+score" for f in tracked.values()}
     totals = {"detect": len(briefs), "track+score": len(tracked)}
     done = dict.fromkeys(totals, 0)
     try:
-        for future in as_completed([*briefs.values(), *tracked], loop=client.loop):
+        for future in as_completed([*briefs.values(), *tracked.values()], loop=client.loop):
             name = stage[future.key]
             done[name] += 1
             if progress:
                 progress(name, done[name], totals[name])
         brief = {k: _outcome(f) for k, f in briefs.items()}
-        outcomes = [_outcome(f) for f in tracked]
-        if cache_mode is CacheMode.CLIENT:
-            for k, b in brief.items():
+        outcomes = [_outcome(tracked[i]) for i in range(len(units))]
+        if client_side:  # fresh detections come back here to be stored
+            for group, b in brief.items():
                 if isinstance(b, _Brief) and b.failed is None and not b.hit:
-                    fresh = prepared[k].result()
-                    cache.store(k[1], fresh.detections)
+                    fresh = prepared[group].result()
+                    cache.store(fresh.key, fresh.detections)
     finally:
-        client.cancel([*prepared.values(), *briefs.values(), *tracked])
+        client.cancel([*prepared.values(), *briefs.values(), *tracked.values()])
     records, failures = [], []
     for (point, _, path), out in zip(units, outcomes, strict=True):
         if isinstance(out, _Failed):
