@@ -51,3 +51,24 @@ def test_map_ordered_keeps_input_order_and_reraises_the_first_error() -> None:
         assert seen == [(1, 3), (2, 3), (3, 3)]
         with pytest.raises(InputError, match="in3: odd"):
             map_ordered(client, _half, [(2,), (3,), (5,)])
+
+
+def test_every_error_survives_the_trip_back_from_a_worker() -> None:
+    import pickle
+
+    from rgbd_eval import errors
+
+    made = [
+        errors.InputError("a.bag", "truncated", topic="/rgb"),
+        errors.TopicError("a.bag", "no depth topic"),
+        errors.GroundTruthError("a.gt.csv", "short row"),
+        errors.TaskError("2 of 6 sweep point(s) failed", 3),
+        errors.CacheError("detection cache c: exists and is not a folder"),
+        errors.ClusterError("cannot reach the scheduler"),
+        errors.ScoringError("nothing to score"),
+    ]
+    for err in made:
+        back = pickle.loads(pickle.dumps(err))
+        assert type(back) is type(err)
+        assert (str(back), back.exit_code, back.__dict__) == (str(err), err.exit_code, err.__dict__)
+    assert pickle.loads(pickle.dumps(made[0])).topic == "/rgb"

@@ -92,3 +92,34 @@ def test_cli_takes_negative_values_as_values(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
     assert [r["tracker.min_confidence"] for r in records] == [-3.0, -2.5, 0.5]
+
+
+def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rgbd_eval.cli.main import app
+
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=2))
+    (tmp_path / "cache").write_text("a file")
+    args = [
+        "sweep",
+        "tracker.min_confidence",
+        "0",
+        "--dataset",
+        str(rec),
+        "--out",
+        str(tmp_path / "o"),
+    ]
+    result = CliRunner().invoke(app, [*args, "--cache", str(tmp_path / "cache")])
+    assert result.exit_code == 4
+    assert result.output.strip().splitlines() == [
+        f"error: detection cache {tmp_path / 'cache'}: exists and is not a folder"
+    ]
+    result = CliRunner().invoke(app, [*args, "--cluster", "local:0"])
+    assert (result.exit_code, result.output.strip()) == (
+        4,
+        "error: --cluster 'local:0': N in local:N must be at least 1",
+    )
+    result = CliRunner().invoke(app, [*args, "--cache-mode", "nfs"])
+    assert result.exit_code == 4 and "expected shared or client" in result.output
+    assert not (tmp_path / "o").exists()

@@ -160,3 +160,27 @@ def test_a_bad_recording_fails_its_points_and_the_others_complete(
     good = [(r["tracker.min_confidence"], r["num_matches"]) for r in report["records"]]
     want = [(r.point["tracker.min_confidence"], r.counts.num_matches) for r in reference.records]
     assert good == [w for w in want if w in good] and len(good) == len(VALUES)
+
+
+def test_run_over_a_folder_on_two_workers(tmp_path: Path, client2: Any) -> None:
+    from rgbd_eval.engine import map_ordered
+    from rgbd_eval.pipeline import run_sequence
+    from tests.io.conftest import Spec, write_recording
+
+    data = tmp_path / "data"
+    paths = [write_recording(data / "a.mcap", "mcap", Spec(n=3))]
+    paths.append(write_recording(data / "b.bag", "ros1", Spec(n=2)))
+    config = load_config(method="basso2012")
+    remote = map_ordered(client2, run_sequence, [(p, config, None) for p in paths])
+    local = [run_sequence(p, config) for p in paths]
+    assert [r.name for r in remote] == ["a", "b"]
+    assert [r.scores.counts for r in remote if r.scores] == [
+        r.scores.counts for r in local if r.scores
+    ]
+    # An error raised on a worker process comes back as the same one-line error and exit code.
+    (data / "c.mcap").write_bytes(b"not a recording")
+    out = tmp_path / "o"
+    result = CliRunner().invoke(app, ["run", str(data), "--out", str(out), "--cluster", "local:2"])
+    assert result.exit_code == 3, result.output
+    assert result.output.startswith(f"error: {data / 'c.mcap'}") and result.output.count("\n") == 1
+    assert not out.exists()

@@ -21,12 +21,25 @@ Exit codes (also in README.md):
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 
 class RgbdEvalError(Exception):
     """Base class. ``exit_code`` is what the CLI exits with."""
 
     exit_code: int = 1
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Errors raised on a cluster worker are pickled back to the client; the subclasses'
+        # own __init__ signatures would break the default (cls(*args)) reconstruction.
+        return (_rebuild, (type(self), str(self), dict(self.__dict__)))
+
+
+def _rebuild(cls: type[RgbdEvalError], message: str, state: dict[str, Any]) -> RgbdEvalError:
+    err = cls.__new__(cls)
+    Exception.__init__(err, message)
+    err.__dict__.update(state)
+    return err
 
 
 class InputError(RgbdEvalError):

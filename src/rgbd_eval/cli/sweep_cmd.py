@@ -103,6 +103,7 @@ def sweep(
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
     from rgbd_eval.atomic import write_json, write_text
+    from rgbd_eval.cache import DetectionCache
     from rgbd_eval.config import load_config
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
@@ -148,6 +149,7 @@ def sweep(
     recordings = [datasets.resolve(n) for n in (names or ["demo"])]
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
     mode = parse_cache_mode(cache_mode)
+    DetectionCache(cache)  # refuses a cache path that is a file before a cluster starts
     spec = parse_cluster(cluster, tasks=len(grid) * len(recordings))
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
     start = time.perf_counter()
