@@ -83,11 +83,16 @@ def test_two_workers_equal_one_bit_for_bit(
     assert (cold.cache_misses, warm.cache_hits) == (2, 2)
     assert records(cold) == records(reference)
     assert records(warm) == records(reference)
-    # The client-side cache mode (workers share no disk) gives the same records too.
-    client_mode = run_sweep(
-        recordings, grid, configs, client2, cache_root=tmp_path, cache_mode=CacheMode.CLIENT
-    )
-    assert client_mode.cache_hits == 2 and records(client_mode) == records(reference)
+    # The client-side cache mode (workers share no disk) gives the same records too: cold (the
+    # fresh detections come back and this process stores them), then warm (sent to workers).
+    own = tmp_path / "client-side"
+    for expected_hits in (0, 2):
+        client_mode = run_sweep(
+            recordings, grid, configs, client2, cache_root=own, cache_mode=CacheMode.CLIENT
+        )
+        assert client_mode.cache_hits == expected_hits
+        assert records(client_mode) == records(reference)
+    assert len(list((own / "detections").rglob("*.det"))) == 2
     # Counts hold floats (IoU sums): compare their exact JSON too, not only ==.
     dump = [json.dumps(r.counts.__dict__, sort_keys=True, default=str) for r in cold.records]
     assert dump == [
