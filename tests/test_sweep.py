@@ -111,7 +111,7 @@ def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: P
         str(tmp_path / "o"),
     ]
     result = CliRunner().invoke(app, [*args, "--cache", str(tmp_path / "cache")])
-    assert result.exit_code == 4
+    assert result.exit_code == 7
     assert result.output.strip().splitlines() == [
         f"error: detection cache {tmp_path / 'cache'}: exists and is not a folder"
     ]

@@ -11,10 +11,11 @@ Exit codes (also in README.md):
 1     ``compare``: a metric regressed beyond its tolerance
 2     command-line usage error; ``compare``: unusable reports
 3     bad input recording (missing, truncated, wrong content)
-4     bad configuration (unknown key, wrong type, value out of range, unusable cache folder)
+4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
-7     the Dask cluster cannot be reached, or a task killed every worker it ran on
+7     an output cannot be written: the detection cache folder is a file or not writable
+8     the Dask cluster cannot be reached, or a task killed every worker it ran on
 ====  =====================================================================
 """
 
@@ -76,8 +77,10 @@ class ConfigError(RgbdEvalError):
     exit_code = 4
 
 
-class CacheError(ConfigError):
+class CacheError(RgbdEvalError):
     """The detection cache folder cannot be used (a file, not writable)."""
+
+    exit_code = 7
 
 
 class GroundTruthError(RgbdEvalError):
@@ -105,7 +108,7 @@ class CompareInputError(RgbdEvalError):
 class ClusterError(RgbdEvalError):
     """The Dask scheduler cannot be reached, or a task lost every worker that ran it."""
 
-    exit_code = 7
+    exit_code = 8
 
 
 class TaskError(RgbdEvalError):
