@@ -50,7 +50,7 @@ def result(recording: Path) -> BenchResult:
 
 
 def test_every_stage_is_present_and_non_negative(result: BenchResult) -> None:
-    expected = [*READ_STAGES, *STAGES, "detections", *LATE_STAGES]
+    expected = [*READ_STAGES, *STAGES, "detections", "track", *LATE_STAGES]
     assert list(result.stage_ms) == expected
     assert all(ms >= 0.0 and math.isfinite(ms) for ms in result.stage_ms.values())
     assert result.frames == FRAMES and result.repeats == 2

@@ -24,42 +24,31 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Protocol, runtime_checkable
 
 from rgbd_eval.config import RunConfig
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError, InputError
 from rgbd_eval.io.benchmark import time_read
-from rgbd_eval.io.reader import open_recording
 from rgbd_eval.pipeline import (
-    SequenceDetections,
+    DETECT_REST,
+    TRACK_REST,
+    detect_and_track,
     find_ground_truth,
     match_ground_truth,
+    open_for,
     score_sequence,
     track_sequence,
 )
-from rgbd_eval.track.protocol import create_tracker
-from rgbd_eval.types import Detection, TrackOutput
+from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
+from rgbd_eval.track.protocol import needs_frame
 
 SCHEMA_VERSION = 2
 
 #: Stages before and after detection, in pipeline order.
 READ_STAGES = ("index", "decode")
-LATE_STAGES = ("track", "score", "other")
-#: The detector's call, for a detector that does not time its own stages.
-DETECT_STAGE = "detect"
-#: The part of a self-timing detector's call outside its named stages.
-DETECT_REST = "detections"
+LATE_STAGES = ("score", "other")
 
 #: Called after each frame with (frames done, frames in all repeats).
 Progress = Callable[[int, int], None]
-
-
-@runtime_checkable
-class TimedDetector(Protocol):
-    """A detector that records the seconds of each stage of its last call."""
-
-    last_timings: dict[str, float]
 
 
 @dataclass(frozen=True)
@@ -199,84 +188,72 @@ def peak_rss_mib() -> float:
     return peak / 1024.0 if os.uname().sysname != "Darwin" else peak / 2.0**20
 
 
-def _add(seconds: dict[str, float], stage: str, value: float) -> None:
-    seconds[stage] = seconds.get(stage, 0.0) + value
-
-
 def _one_repeat(
     path: Path, config: RunConfig, done: int, total: int, progress: Progress | None
 ) -> _Repeat:
-    """Stream the recording once through detector, tracker and scorer, timing each stage."""
-    seconds: dict[str, float] = dict.fromkeys(READ_STAGES, 0.0)
+    """Stream the recording once through detector, tracker and scorer (the loop of ``run``)."""
     wall = time.perf_counter()
-    recording = open_recording(path, config.io)
-    seconds["index"] = time.perf_counter() - wall
+    recording = open_for(path, config)
+    index_s = time.perf_counter() - wall
     start = time.perf_counter()
     gt = find_ground_truth(path, recording, None)
     gt_s = time.perf_counter() - start
-    detector = create_detector(config.method, config)
-    tracker = create_tracker(config.method, config)
-    stamps: list[int] = []
-    tracks: list[tuple[TrackOutput, ...]] = []
-    per_frame: list[tuple[Detection, ...]] = []
-    detections = 0
-    rgb_size = depth_size = (0, 0)
-    start = time.perf_counter()
-    for frame in recording.frames():
-        t0 = time.perf_counter()
-        seconds["decode"] += t0 - start
-        dets = detector.detect(frame)
-        t1 = time.perf_counter()
-        if isinstance(detector, TimedDetector):
-            stages = detector.last_timings
-            for stage, value in stages.items():
-                _add(seconds, stage, value)
-            _add(seconds, DETECT_REST, max(0.0, (t1 - t0) - sum(stages.values())))
-        else:
-            _add(seconds, DETECT_STAGE, t1 - t0)
-        tracks.append(tuple(tracker.update(frame.stamp_ns, dets)))
-        start = time.perf_counter()
-        _add(seconds, "track", start - t1)
-        stamps.append(frame.stamp_ns)
-        per_frame.append(tuple(dets))
-        detections += len(dets)
-        rgb_size = (frame.rgb.shape[1], frame.rgb.shape[0])
-        depth_size = (frame.depth.shape[1], frame.depth.shape[0])
+
+    def advance(frames_done: int, _frames: int) -> None:
         if progress is not None:
-            progress(done + len(stamps), total)
+            progress(done + frames_done, total)
+
+    detections, tracks = detect_and_track(recording, config, advance, keep_appearance=True)
     start = time.perf_counter()
     scored = gt is not None
     if gt is not None:
-        score_sequence(match_ground_truth(gt, stamps, config), tracks, config)
-    seconds["score"] = gt_s + time.perf_counter() - start
+        score_sequence(match_ground_truth(gt, detections.stamps_ns, config), tracks, config)
+    score_s = gt_s + time.perf_counter() - start
     wall_s = time.perf_counter() - wall
+    seconds = {"index": index_s, "decode": detections.seconds["read"]}
+    seconds.update(
+        {
+            k.removeprefix("stage."): v
+            for k, v in detections.seconds.items()
+            if k.startswith("stage.")
+        }
+    )
+    seconds["score"] = score_s
     seconds["other"] = max(0.0, wall_s - sum(seconds.values()))
     start = time.perf_counter()
-    track_sequence(SequenceDetections(tuple(stamps), tuple(per_frame)), config)
+    track_sequence(detections, config, open_for(path, config) if needs_frame(config) else None)
     track_alone_s = time.perf_counter() - start
+    first = next(recording.frames(), None) if detections.stamps_ns else None
+    sizes = (
+        {}
+        if first is None
+        else {r: (s.image.shape[1], s.image.shape[0]) for r, s in first.streams.items()}
+    )
     return _Repeat(
-        frames=len(stamps),
+        frames=len(detections.stamps_ns),
         seconds=seconds,
         wall_s=wall_s,
-        detections=detections,
+        detections=sum(len(d) for d in detections.detections),
         tracks=sum(len(t) for t in tracks),
         scored=scored,
-        rgb_size=rgb_size,
-        depth_size=depth_size,
+        rgb_size=sizes.get("colour", (0, 0)),
+        depth_size=sizes.get("depth", (0, 0)),
         track_alone_s=track_alone_s,
     )
 
 
-def _stage_order(stages: set[str]) -> list[str]:
-    middle = sorted(stages - set(READ_STAGES) - set(LATE_STAGES), key=_detector_rank)
-    return [*READ_STAGES, *middle, *LATE_STAGES]
-
-
-def _detector_rank(stage: str) -> tuple[int, str]:
-    from rgbd_eval.detect.basso2012 import STAGES
-
-    order = (*STAGES, DETECT_REST, DETECT_STAGE)
-    return (order.index(stage), stage) if stage in order else (len(order), stage)
+def _stage_order(stages: set[str], config: RunConfig) -> list[str]:
+    """Reading, the detector's stages, the tracker's, then scoring, in pipeline order."""
+    order = (
+        *READ_STAGES,
+        *detector_spec(config.detector.name).stages,
+        DETECT_REST,
+        *tracker_spec(config.tracker.name).stages,
+        TRACK_REST,
+        *LATE_STAGES,
+    )
+    known = [s for s in order if s in stages]
+    return [*known, *sorted(stages - set(known))]
 
 
 def benchmark(
@@ -298,7 +275,11 @@ def benchmark(
     raw_reader = ""
     for _ in range(repeats):
         # decode-only floor first, then the pipeline: both see the same cache state
-        read = time_read(path, config.io)
+        read = time_read(
+            path,
+            config.io,
+            streams_of(detector_spec(config.detector.name), tracker_spec(config.tracker.name)),
+        )
         if read.frames == 0:
             raise InputError(path, "no synchronised RGB/depth frames to benchmark")
         frames = read.frames
@@ -308,7 +289,7 @@ def benchmark(
         raw_reader = read.raw_floor_reader
         runs.append(_one_repeat(path, config, len(runs) * frames, total, progress))
     frames = runs[0].frames
-    stages = _stage_order({s for r in runs for s in r.seconds})
+    stages = _stage_order({s for r in runs for s in r.seconds}, config)
     stage_ms = {
         s: statistics.median(r.seconds.get(s, 0.0) * 1e3 / frames for r in runs) for s in stages
     }
@@ -316,7 +297,7 @@ def benchmark(
     return BenchResult(
         schema_version=SCHEMA_VERSION,
         path=str(path),
-        method=config.method,
+        method=f"{config.method} ({config.detector.name} + {config.tracker.name})",
         frames=frames,
         repeats=repeats,
         rgb_size=first.rgb_size,

@@ -1,8 +1,8 @@
 """Content-addressed on-disk cache of detections, safe to share between processes and machines.
 
-Detections are a pure function of (recording, io config, method, detector
-config), so a sweep over tracker parameters runs detection once per sequence.
-The key is the sha256 of exactly those inputs (:func:`detection_key`).
+Detections are a pure function of (recording, io config, detector config: its
+``name`` included), so a sweep over tracker parameters runs detection once per
+sequence. The key is the sha256 of exactly those inputs (:func:`detection_key`).
 
 An entry is one file, ``detections/<key[:2]>/<key>.det``: a magic line, the
 sha256 of the payload in hex, a newline, then the payload, an uncompressed
@@ -37,7 +37,7 @@ from rgbd_eval.pipeline import SequenceDetections
 from rgbd_eval.types import Box2D, Box3D, Detection
 
 #: Bump when the Detection layout or the detector's behaviour changes incompatibly.
-CACHE_FORMAT = 2
+CACHE_FORMAT = 3  # 3: checksummed npz entries (1 and 2 were pickles)
 _MAGIC = b"rgbd-eval detections 2\n"
 _DIGEST_LEN = 64  # hex sha256
 
@@ -56,7 +56,6 @@ def detector_inputs(config: RunConfig) -> str:
     payload = {
         "format": CACHE_FORMAT,
         "tool": __version__,
-        "method": config.method,
         "io": config.io.model_dump(mode="json"),
         "detector": config.detector.model_dump(mode="json"),
     }

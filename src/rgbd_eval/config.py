@@ -1,8 +1,10 @@
 """Typed configuration: models that reject unknown keys, YAML loading, ``--set`` overrides.
 
-A run is configured by one :class:`RunConfig`. Its defaults are the published
-parameters of the reference system (seed 000, Tables 5.1 and 6.1); the files in
-``configs/methods/`` restate them per method. Overrides use dotted keys::
+A run is configured by one :class:`RunConfig`: the method, how recordings are read,
+the detector's and the tracker's config models (registered by name, see
+:mod:`rgbd_eval.plugins`) and the scoring. Each method's defaults are its paper's
+published parameters, restated in ``configs/methods/<method>.yaml``. Overrides use
+dotted keys::
 
     tracker.min_confidence=-1.0     detector.voxel_size=0.08     io.max_sync_gap_ms=20
 """
@@ -10,12 +12,21 @@ parameters of the reference system (seed 000, Tables 5.1 and 6.1); the files in
 from __future__ import annotations
 
 import enum
+import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, get_origin
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializeAsAny,
+    ValidationError,
+    model_validator,
+)
+from pydantic_core import PydanticCustomError
 
 from rgbd_eval.errors import ConfigError
 
@@ -24,210 +35,60 @@ class _Model(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
 
 
+class ComponentConfig(_Model):
+    """Base of every detector's and tracker's config model; ``name`` selects the model.
+
+    A subclass narrows ``name`` to its registered name (``name: Literal["x"] = "x"``),
+    see :mod:`rgbd_eval.plugins`.
+    """
+
+    name: str
+
+
+#: Roles of non-image topics that ``io.topics`` may also name.
+_OTHER_ROLES = ("odometry", "ground_truth")
+
+
+def _check_role(role: str) -> None:
+    from rgbd_eval.plugins import ROLES, role_kind
+
+    kind = role_kind(role.removesuffix("_info"))
+    if role in _OTHER_ROLES or kind in ROLES:
+        return
+    known = ", ".join([*ROLES, *(f"{r}_info" for r in ROLES), *_OTHER_ROLES, "depth_2, ..."])
+    raise ValueError(f"unknown topic role {role!r} (known: {known})")
+
+
 class IoConfig(_Model):
     """How a recording is read."""
 
-    rgb_topic: str | None = Field(None, description="RGB image topic; auto-detected when unset")
-    depth_topic: str | None = Field(None, description="depth image topic; auto-detected when unset")
-    rgb_info_topic: str | None = Field(None, description="RGB CameraInfo topic; auto-detected")
-    depth_info_topic: str | None = Field(None, description="depth CameraInfo topic; auto-detected")
-    odom_topic: str | None = Field(None, description="nav_msgs/Odometry topic; auto-detected")
-    gt_topic: str | None = Field(None, description="ground-truth topic; auto-detected")
+    topics: dict[str, str] = Field(
+        default_factory=dict,
+        description="topic per role: colour, depth (depth_2, ... for more depth cameras), "
+        "thermal, left, right, <role>_info (its CameraInfo), odometry, ground_truth; "
+        "auto-detected by message type where unset and unambiguous",
+    )
     world_frame: str | None = Field(
         None, description="world frame of the tf tree (default: the odometry's frame, else 'odom')"
     )
     max_sync_gap_ms: float = Field(
-        20.0, gt=0, le=1000, description="largest RGB/depth header-stamp gap that still pairs"
+        20.0, gt=0, le=1000, description="largest header-stamp gap between streams that still pairs"
     )
     max_pose_extrapolation_ms: float = Field(
         200.0, ge=0, description="how far a pose may be held beyond the first/last odometry stamp"
     )
 
-
-class GroundMode(enum.Enum):
-    """How the detector finds the ground plane first (seed 000, 5.1, 5.4.1)."""
-
-    AUTO = "auto"
-    POINTS = "points"
-    PLANE = "plane"
-
-
-class DetectorConfig(_Model):
-    """The basso2012 detector (seed 000, chapter 5; defaults from Table 5.1, voxel 0.06 m)."""
-
-    voxel_size: float = Field(0.06, gt=0.0, le=0.5, description="voxel grid side (m), Table 5.1")
-    min_height: float = Field(1.4, ge=0.0, description="Table 5.1 ~people/min_height (m)")
-    max_height: float = Field(2.3, gt=0.0, description="Table 5.1 ~people/max_height (m)")
-    min_confidence: float = Field(-1.5, description="Table 5.1 ~people/min_confidence")
-    publish_all: bool = Field(True, description="Table 5.1 ~people/publish_all")
-    head_centroid: bool = Field(True, description="Table 5.1 ~people/head_centroid")
-    max_distance: float = Field(6.5, gt=0.0, description="Table 5.1 ~people/max_distance (m)")
-    min_points: int = Field(30, ge=1, description="Table 5.1 ~cluster/min_points")
-    max_points: int = Field(600, ge=1, description="Table 5.1 ~cluster/max_points")
-    cluster_tolerance_voxels: float = Field(
-        2.0, gt=0.0, description="Euclidean clustering tolerance in voxels (5.4.2: 2 x voxel)"
-    )
-    ground_mode: GroundMode = Field(GroundMode.AUTO, description="initial ground plane source")
-    ground_points: list[tuple[float, float, float]] | None = Field(
-        None, description="three floor points (x, y, z) in the depth optical frame, mode 'points'"
-    )
-    ground_plane: tuple[float, float, float, float] | None = Field(
-        None, description="plane a, b, c, d in the depth optical frame, mode 'plane'"
-    )
-    histogram_bins: int = Field(
-        8, ge=2, le=32, description="bins per channel of the blob's 3D colour histogram (6.2.2)"
-    )
-    hog_default_confidence: float = Field(
-        -100.0, description="confidence of clusters not visible top to bottom (5.4.2)"
-    )
-    ground_pixels: list[tuple[float, float]] | None = Field(
-        None,
-        description="three floor pixels (u, v) on the RGB image, mode 'points' "
-        "(the ground_detector's mouse clicks, 5.4.1)",
-    )
-    ground_max_tilt_deg: float = Field(
-        30.0,
-        gt=0.0,
-        lt=90.0,
-        description="largest angle between the floor normal and gravity (odometry up) accepted "
-        "by the automatic ground search; covers the Kinect's +-27 deg tilt (seed 000, 2.1)",
-    )
-    ground_min_points: int = Field(
-        30,
-        ge=3,
-        description="fewest floor voxels within one voxel of the plane needed to refine it; "
-        "with fewer the previous plane is kept (5.1, 5.4.2; as ~cluster/min_points, Table 5.1)",
-    )
-    subclustering: bool = Field(
-        True,
-        description="head-based sub-clustering of Munaro, Basso and Menegatti (IROS 2012), the "
-        "thesis authors' follow-up; off = the thesis' plain Euclidean clusters (5.2)",
-    )
-    min_head_distance: float = Field(
-        0.3,
-        gt=0.0,
-        description="smallest ground distance (m) between two heads and the distance below "
-        "which clusters are merged (Munaro et al. IROS 2012; 0.3 m in PCL's people module)",
-    )
-    min_head_prominence: float = Field(
-        0.1,
-        ge=0.0,
-        description="how far (m) a second head must rise above the lowest point between it and "
-        "a higher head; the head-to-shoulder drop of an adult is about 0.3 m",
-    )
-    surface_correction: bool = Field(
-        True,
-        description="move the head centroid from the visible surface to the head's axis "
-        "(4/3 of the across-view spread, exact for a sphere or upright cylinder); off = the "
-        "surface mean of 5.3",
-    )
-    hog_max_ground_gap: float = Field(
-        0.3,
-        gt=0.0,
-        description="a cluster is 'visible from top to bottom' (5.4.2), so HOG-scored, when its "
-        "lowest point is at most this high (m) and its full-body box is on the image",
-    )
-
     @model_validator(mode="after")
-    def _check(self) -> DetectorConfig:
-        if self.min_height >= self.max_height:
-            raise ValueError(
-                f"min_height={self.min_height} must be below max_height={self.max_height}"
-            )
-        if self.min_points > self.max_points:
-            raise ValueError(
-                f"min_points={self.min_points} must not exceed max_points={self.max_points}"
-            )
-        if self.ground_mode is GroundMode.POINTS and not (
-            (self.ground_points is not None and len(self.ground_points) == 3)
-            or (self.ground_pixels is not None and len(self.ground_pixels) == 3)
-        ):
-            raise ValueError(
-                "ground_mode 'points' needs exactly three ground_points (3D) or ground_pixels "
-                f"(RGB image), got ground_points={self.ground_points}, "
-                f"ground_pixels={self.ground_pixels}"
-            )
-        if self.ground_mode is GroundMode.PLANE and self.ground_plane is None:
-            raise ValueError("ground_mode 'plane' needs ground_plane: [a, b, c, d]")
+    def _check(self) -> IoConfig:
+        for role, topic in self.topics.items():
+            _check_role(role)
+            if not topic.strip():
+                raise ValueError(f"topics.{role}: empty topic name")
         return self
 
-
-class ClusterSelection(enum.Enum):
-    """Which detections reach the tracker (seed 000, Table 7.4)."""
-
-    HEIGHT = "height"
-    CONFIDENCE = "confidence"
-
-
-class TrackerConfig(_Model):
-    """The basso2012 tracker (seed 000, chapter 6; defaults from Table 6.1).
-
-    Frame counts are given at ``reference_rate_hz`` (the Kinect's 30 Hz) and
-    converted to seconds, so that they mean the same time at any frame rate:
-    ``frames_before_old: 90`` is 3 s.
-    """
-
-    gate_distance_probability: float = Field(
-        0.999, gt=0.0, lt=1.0, description="Table 6.1 ~kalman/gate_distance_probability"
-    )
-    acceleration_variance: float = Field(
-        4.0, gt=0.0, description="Table 6.1 ~kalman/acceleration_variance (m^2/s^4)"
-    )
-    depth_noise_coefficient: float = Field(
-        0.001425,
-        ge=0.0,
-        description="Kinect depth error sigma = k * d^2 (m), Figure 6.1; k from Khoshelham & Elberink 2012",
-    )
-    weak_classifiers: int = Field(250, ge=1, description="Table 6.1 ~recovery/weak_classifiers")
-    selectors: int = Field(50, ge=1, description="Table 6.1 ~recovery/selectors")
-    min_prediction: float = Field(9.0, description="Table 6.1 ~recovery/min_prediction")
-    min_confidence: float = Field(-0.5, description="Table 6.1 ~target/min_confidence")
-    frames_before_old: int = Field(90, ge=0, description="Table 6.1 ~target/frames_before_old")
-    frames_before_fake: int = Field(60, ge=1, description="Table 6.1 ~target/frames_before_fake")
-    frames_remain_new: int = Field(30, ge=0, description="Table 6.1 ~target/frames_remain_new")
-    detections_to_validate: int = Field(
-        3, ge=1, description="Table 6.1 ~target/detections_to_validate"
-    )
-    reference_rate_hz: float = Field(30.0, gt=0.0, description="rate the frame counts refer to")
-    classifier: bool = Field(True, description="online classifier on/off (Table 7.5)")
-    classifier_memory_s: float | None = Field(
-        None,
-        ge=0.0,
-        description="how long a lost track's classifier is kept (Figure 7.7); "
-        "default frames_before_old / reference_rate_hz",
-    )
-    selection: ClusterSelection = Field(
-        ClusterSelection.HEIGHT, description="cluster selection (Table 7.4)"
-    )
-    selection_confidence: float = Field(
-        -3.0, description="HOG threshold when selection is 'confidence' (7.3)"
-    )
-    seed: int = Field(0, ge=0, description="seed of the classifier's random features")
-    initial_velocity_variance: float = Field(
-        1.0,
-        gt=0.0,
-        description="variance (m^2/s^2) of a new track's unknown velocity; not given in "
-        "seed 000 (6.1): 1 m/s standard deviation covers walking speeds",
-    )
-    classifier_learning_rate: float = Field(
-        0.05,
-        gt=0.0,
-        le=1.0,
-        description="floor of the gain of the weak classifiers' running class means "
-        "(seed 000 6.5.3 follows Grabner and Bischof [13]; the value is not given)",
-    )
-
-    @model_validator(mode="after")
-    def _check(self) -> TrackerConfig:
-        if self.selectors > self.weak_classifiers:
-            raise ValueError(
-                f"selectors={self.selectors} must not exceed weak_classifiers={self.weak_classifiers}"
-            )
-        return self
-
-    def seconds(self, frames: int) -> float:
-        """A frame count of Table 6.1 as seconds."""
-        return frames / self.reference_rate_hz
+    def topic(self, role: str) -> str | None:
+        """The topic chosen for ``role`` in the config, if any."""
+        return self.topics.get(role)
 
 
 class Gating(enum.Enum):
@@ -264,29 +125,115 @@ class EvaluationConfig(_Model):
 
 
 class RunConfig(_Model):
-    """Everything one run needs besides the input paths."""
+    """Everything one run needs besides the input paths.
 
-    method: str = Field("basso2012", description="detector/tracker pairing by name")
+    ``detector`` and ``tracker`` are the config models registered under their
+    ``name`` (:mod:`rgbd_eval.plugins`); when a section or its name is absent, the
+    method's pairing fills it in. Build from raw data with :func:`build_config`,
+    which names the offending key of a bad section.
+    """
+
+    method: str = Field("basso2012", description="the method (paper pairing) by name")
     io: IoConfig = IoConfig()
-    detector: DetectorConfig = DetectorConfig()
-    tracker: TrackerConfig = TrackerConfig()
+    detector: SerializeAsAny[ComponentConfig] = Field(
+        default_factory=lambda: _unresolved("detector")
+    )
+    tracker: SerializeAsAny[ComponentConfig] = Field(default_factory=lambda: _unresolved("tracker"))
     evaluation: EvaluationConfig = EvaluationConfig()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _resolve_sections(cls, data: Any) -> Any:
+        if not isinstance(data, Mapping):
+            return data
+        out = dict(data)
+        method = out.get("method", cls.model_fields["method"].default)
+        for section in ("detector", "tracker"):
+            value = out.get(section)
+            if isinstance(value, ComponentConfig):
+                continue
+            try:
+                out[section] = _section(section, value, method)
+            except ValidationError as err:
+                raise PydanticCustomError(
+                    "section", format_validation_error(err, section, prefix=section)
+                ) from err
+            except ConfigError as err:
+                raise PydanticCustomError("section", str(err)) from err
+        return out
+
+    @model_validator(mode="after")
+    def _check_pairing(self) -> RunConfig:
+        from rgbd_eval.plugins import pairing_problem
+
+        problem = pairing_problem(self.detector, self.tracker)
+        if problem is not None:
+            raise ValueError(
+                f"detector {self.detector.name!r} cannot feed tracker {self.tracker.name!r}: "
+                f"{problem}"
+            )
+        return self
+
+
+def _unresolved(section: str) -> ComponentConfig:
+    raise RuntimeError(f"{section} is filled in from the method before validation")
+
+
+def _section(section: str, value: Any, method: Any) -> ComponentConfig:
+    """The config model of ``section`` ('detector'/'tracker') validated from raw ``value``."""
+    from rgbd_eval.plugins import detector_spec, method_spec, tracker_spec
+
+    if value is None:
+        value = {}
+    if not isinstance(value, Mapping):
+        raise ConfigError(f"{section}: expected a mapping, got {type(value).__name__}")
+    name = value.get("name")
+    if name is None:
+        if not isinstance(method, str):
+            raise ConfigError(f"method: expected a name, got {method!r}")
+        spec = method_spec(method)
+        name = spec.detector if section == "detector" else spec.tracker
+    if not isinstance(name, str):
+        raise ConfigError(f"{section}.name: expected a name, got {name!r}")
+    lookup = detector_spec if section == "detector" else tracker_spec
+    model = lookup(name).config_model
+    return model.model_validate({**value, "name": name})
+
+
+def section_model(section: str, data: Mapping[str, Any]) -> type[BaseModel]:
+    """The model of ``detector``/``tracker`` that raw run-config ``data`` selects."""
+    from rgbd_eval.plugins import detector_spec, method_spec, tracker_spec
+
+    raw = data.get(section)
+    name = raw.get("name") if isinstance(raw, Mapping) else None
+    if not isinstance(name, str):
+        method = data.get("method", RunConfig.model_fields["method"].default)
+        spec = method_spec(str(method))
+        name = spec.detector if section == "detector" else spec.tracker
+    return (detector_spec if section == "detector" else tracker_spec)(name).config_model
 
 
 # ----------------------------------------------------------------------------- loading
 
 
-def format_validation_error(err: ValidationError, source: str) -> str:
+def validation_parts(err: ValidationError, prefix: str = "") -> list[tuple[str, str]]:
+    """``(dotted location, message)`` of each error, the location under ``prefix``."""
     parts = []
     for e in err.errors():
-        loc = ".".join(str(p) for p in e["loc"])
+        loc = ".".join(str(p) for p in (prefix, *e["loc"]) if p != "")
         msg = e["msg"]
         if e["type"] == "extra_forbidden":
             msg = "unknown key"
         value = e.get("input")
         shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r})"
-        parts.append(f"{loc or '<root>'}: {msg}{shown}")
-    return f"{source}: " + "; ".join(parts)
+        parts.append((loc, f"{msg}{shown}"))
+    return parts
+
+
+def format_validation_error(err: ValidationError, source: str, prefix: str = "") -> str:
+    """One line: ``source: loc: message; loc: message``."""
+    parts = validation_parts(err, prefix)
+    return f"{source}: " + "; ".join(f"{loc or '<root>'}: {msg}" for loc, msg in parts)
 
 
 def _parse_value(text: str) -> Any:
@@ -297,17 +244,25 @@ def _parse_value(text: str) -> Any:
         return text
 
 
+_SECTIONS = ("detector", "tracker")
+
+
 def set_dotted(
     data: dict[str, Any], key: str, value: Any, model: type[BaseModel] | None = None
 ) -> None:
     """Set ``a.b.c = value`` in the raw mapping of ``model`` (default :class:`RunConfig`).
 
     Every segment must be a field of its section; a ConfigError names the unknown key.
+    In a run config, ``detector.*``/``tracker.*`` keys are those of the model the
+    section's ``name`` selects, and setting another ``name`` starts that section afresh
+    (the other component's parameters do not apply to it). A mapping field (``io.topics``)
+    takes one more segment as its key.
     """
     parts = key.split(".")
     if not all(parts):
         raise ConfigError(f"override {key!r}: empty key segment")
-    fields: Mapping[str, Any] = (model or RunConfig).model_fields
+    root = model or RunConfig
+    fields: Mapping[str, Any] = root.model_fields
     node = data
     for i, part in enumerate(parts):
         where = ".".join(parts[:i]) or "<root>"
@@ -320,7 +275,24 @@ def set_dotted(
             node[part] = value
             return
         annotation = fields[part].annotation
-        if not (isinstance(annotation, type) and issubclass(annotation, BaseModel)):
+        section: type[BaseModel] | None = None
+        if root is RunConfig and i == 0 and part in _SECTIONS:
+            sub_raw = node.get(part)
+            if parts[1:] == ["name"] and len(parts) == 2:
+                old = sub_raw.get("name") if isinstance(sub_raw, Mapping) else None
+                if old != value:
+                    node[part] = {"name": value}
+                    return
+            section = section_model(part, node)
+        elif isinstance(annotation, type) and issubclass(annotation, BaseModel):
+            section = annotation
+        elif get_origin(annotation) is dict and i == len(parts) - 2:
+            sub = node.setdefault(part, {})
+            if not isinstance(sub, dict):
+                raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])} is not a mapping")
+            sub[parts[-1]] = value
+            return
+        if section is None:
             raise ConfigError(
                 f"override {key!r}: {where}.{part} is not a section".replace("<root>.", "")
             )
@@ -328,7 +300,7 @@ def set_dotted(
         if not isinstance(sub, dict):
             raise ConfigError(f"override {key!r}: {'.'.join(parts[: i + 1])} is not a section")
         node = sub
-        fields = annotation.model_fields
+        fields = section.model_fields
 
 
 def parse_overrides(items: Iterable[str]) -> list[tuple[str, Any]]:
@@ -349,14 +321,41 @@ def build_config(
     overrides: Iterable[tuple[str, Any]] = (),
     source: str = "config",
 ) -> RunConfig:
-    """Validate a config mapping with overrides applied on top."""
+    """Validate a config mapping with overrides applied on top.
+
+    The method and the detector/tracker names are checked first (an unknown name lists
+    the known ones), then every section; an error in an overridden key is blamed on
+    its ``--set``, any other on ``source``.
+    """
+    from rgbd_eval.plugins import method_spec
+
     merged: dict[str, Any] = _deep_copy(dict(data or {}))
+    overridden = []
     for key, value in overrides:
         set_dotted(merged, key, value)
-    try:
-        return RunConfig.model_validate(merged)
-    except ValidationError as err:
-        raise ConfigError(format_validation_error(err, source)) from err
+        overridden.append((key, value))
+    method = merged.get("method", RunConfig.model_fields["method"].default)
+    if not isinstance(method, str):
+        raise ConfigError(f"{source}: method: expected a name, got {method!r}")
+    method_spec(method)
+    parts: list[tuple[str, str]] = []
+    for section in _SECTIONS:
+        try:
+            merged[section] = _section(section, merged.get(section), method)
+        except ValidationError as err:
+            parts += validation_parts(err, section)
+    if not parts:
+        try:
+            return RunConfig.model_validate(merged)
+        except ValidationError as err:
+            parts = validation_parts(err)
+    blamed = []
+    for loc, msg in parts:
+        by = next(
+            (f"--set {k}={v}" for k, v in overridden if loc == k or loc.startswith(f"{k}.")), None
+        )
+        blamed.append(f"{by or source}: {loc or '<root>'}: {msg}")
+    raise ConfigError("; ".join(blamed))
 
 
 def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:
@@ -380,21 +379,36 @@ def load_yaml(path: Path) -> dict[str, Any]:
     return data
 
 
+def method_defaults(method: str) -> tuple[dict[str, Any], str]:
+    """The raw config of a method: its paper's defaults file, else its pairing and gating."""
+    from rgbd_eval.plugins import method_spec
+
+    spec = method_spec(method)
+    if spec.config_file is not None:
+        path = config_dir() / spec.config_file
+        data = load_yaml(path)
+        data["method"] = method
+        return data, str(path)
+    return {"method": method, "evaluation": {"gating": spec.gating}}, f"method {method}"
+
+
 def load_config(
     path: Path | None = None, overrides: Iterable[str] = (), method: str | None = None
 ) -> RunConfig:
-    """Load a run config from a YAML file (or the method's defaults) plus ``--set`` overrides."""
+    """Load a run config from a YAML file (or the method's defaults) plus ``--set`` overrides.
+
+    The config is complete and checked before any recording is opened: an unknown
+    method, detector, tracker or key is a :class:`ConfigError` (exit 4).
+    """
     data: dict[str, Any] = {}
     source = "defaults"
-    if path is None and method is not None:
-        method_file = methods_dir() / f"{method}.yaml"
-        if method_file.is_file():
-            path = method_file
     if path is not None:
         data = load_yaml(path)
         source = str(path)
-    if method is not None:
-        data["method"] = method
+        if method is not None:
+            data["method"] = method
+    elif method is not None:
+        data, source = method_defaults(method)
     return build_config(data, parse_overrides(overrides), source)
 
 
@@ -403,10 +417,44 @@ def config_to_dict(config: RunConfig) -> dict[str, Any]:
     return config.model_dump(mode="json")
 
 
+# ----------------------------------------------------------------------------- resources
+
+
 def repo_root() -> Path:
-    """The source checkout's root (where ``configs/`` and ``datasets/`` live)."""
+    """The source checkout's root, when running from one (else the package's parent)."""
     return Path(__file__).resolve().parents[2]
 
 
+def in_checkout() -> bool:
+    """Whether the package runs from a source checkout (editable install or PYTHONPATH)."""
+    root = repo_root()
+    return (root / "pyproject.toml").is_file() and (root / "configs").is_dir()
+
+
+def config_dir() -> Path:
+    """The shipped configs: methods, papers, scenarios, sweeps, baselines.
+
+    From a checkout, its ``configs/``; from an installed wheel, the copy built into
+    the package (``rgbd_eval/configs``, see ``setup.py``).
+    """
+    packaged = Path(__file__).resolve().parent / "configs"
+    return repo_root() / "configs" if in_checkout() else packaged
+
+
+def data_home() -> Path:
+    """Where generated recordings go: ``datasets/`` in a checkout, else a user cache folder.
+
+    Outside a checkout: ``$RGBD_EVAL_DATA``, else ``$XDG_CACHE_HOME/rgbd-eval/datasets``
+    (default ``~/.cache/rgbd-eval/datasets``).
+    """
+    env = os.environ.get("RGBD_EVAL_DATA")
+    if env:
+        return Path(env)
+    if in_checkout():
+        return repo_root() / "datasets"
+    cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
+    return Path(cache) / "rgbd-eval" / "datasets"
+
+
 def methods_dir() -> Path:
-    return repo_root() / "configs" / "methods"
+    return config_dir() / "methods"

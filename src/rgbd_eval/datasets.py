@@ -4,16 +4,16 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from rgbd_eval.config import repo_root
+from rgbd_eval.config import config_dir, data_home
 from rgbd_eval.errors import InputError
 
 
 def datasets_dir() -> Path:
-    return repo_root() / "datasets"
+    return data_home()
 
 
 def scenarios_dir() -> Path:
-    return repo_root() / "configs" / "scenarios"
+    return config_dir() / "scenarios"
 
 
 def known_names() -> list[str]:

@@ -8,21 +8,25 @@ scoring.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from rgbd_eval.config import Gating, RunConfig
 from rgbd_eval.detect.protocol import create_detector
-from rgbd_eval.errors import ScoringError
+from rgbd_eval.errors import ConfigError, InputError, ScoringError
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
 from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence
-from rgbd_eval.track.protocol import create_tracker
-from rgbd_eval.types import Detection, GroundTruthObject, TrackOutput
+from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
+from rgbd_eval.track.protocol import create_tracker, needs_frame
+from rgbd_eval.types import Detection, Frame, GroundTruthObject, TrackOutput
 
 #: Called after each frame with (frames done, frames in all).
 Progress = Callable[[int, int], None]
+#: Stage names for what a detector's / tracker's call spends outside its named stages.
+DETECT_REST = "detections"
+TRACK_REST = "track"
 
 
 @dataclass(frozen=True)
@@ -69,15 +73,34 @@ def sidecar_path(path: Path) -> Path | None:
     return candidate if candidate.exists() else None
 
 
+def open_for(path: Path, config: RunConfig) -> Recording:
+    """Open ``path`` for the streams the configured detector and tracker read."""
+    streams = streams_of(detector_spec(config.detector.name), tracker_spec(config.tracker.name))
+    return open_recording(path, config.io, streams)
+
+
+def _add_stages(
+    stages: dict[str, float], timings: Mapping[str, float], rest: str, total: float
+) -> None:
+    """Add a component's named stage seconds, and what its call spent outside them as ``rest``."""
+    named = 0.0
+    for stage, sec in timings.items():
+        stages[stage] = stages.get(stage, 0.0) + sec
+        named += sec
+    stages[rest] = stages.get(rest, 0.0) + max(0.0, total - named)
+
+
 def _detect_frames(
-    recording: Recording, config: RunConfig, seconds: dict[str, float]
-) -> Iterator[tuple[int, tuple[Detection, ...]]]:
-    """``(stamp, detections)`` of every frame from a fresh detector.
+    recording: Recording, config: RunConfig, seconds: dict[str, float], stages: dict[str, float]
+) -> Iterator[tuple[Frame, tuple[Detection, ...]]]:
+    """``(frame, detections)`` of every frame from a fresh detector.
 
     Adds the seconds spent reading and detecting to ``seconds["read"]`` and
-    ``seconds["detect"]``; the consumer's time between frames is counted in neither.
+    ``seconds["detect"]``, and the detector's own stages (:attr:`Detector.last_timings`,
+    the rest of its call as ``detections``) to ``stages``; the consumer's time between
+    frames is counted in neither.
     """
-    detector = create_detector(config.method, config)
+    detector = create_detector(config)
     start = time.perf_counter()
     for frame in recording.frames():
         t0 = time.perf_counter()
@@ -85,8 +108,13 @@ def _detect_frames(
         t1 = time.perf_counter()
         seconds["read"] += t0 - start
         seconds["detect"] += t1 - t0
-        yield frame.stamp_ns, dets
+        _add_stages(stages, detector.last_timings, DETECT_REST, t1 - t0)
+        yield frame, dets
         start = time.perf_counter()
+
+
+def _stage_seconds(seconds: dict[str, float], stages: dict[str, float]) -> dict[str, float]:
+    return {**seconds, **{f"stage.{k}": v for k, v in stages.items()}}
 
 
 def detect_sequence(
@@ -94,51 +122,82 @@ def detect_sequence(
 ) -> SequenceDetections:
     """Run the configured detector on every frame (a fresh detector per sequence)."""
     seconds = {"read": 0.0, "detect": 0.0}
+    stages: dict[str, float] = {}
     stamps: list[int] = []
     per_frame: list[tuple[Detection, ...]] = []
-    for stamp, dets in _detect_frames(recording, config, seconds):
-        stamps.append(stamp)
+    for frame, dets in _detect_frames(recording, config, seconds, stages):
+        stamps.append(frame.stamp_ns)
         per_frame.append(dets)
         if progress is not None:
             progress(len(per_frame), len(recording))
-    return SequenceDetections(tuple(stamps), tuple(per_frame), seconds)
+    return SequenceDetections(tuple(stamps), tuple(per_frame), _stage_seconds(seconds, stages))
 
 
 def track_sequence(
-    detections: SequenceDetections, config: RunConfig
+    detections: SequenceDetections, config: RunConfig, recording: Recording | None = None
 ) -> tuple[tuple[TrackOutput, ...], ...]:
-    """Run the configured tracker over per-frame detections (a fresh tracker per sequence)."""
-    tracker = create_tracker(config.method, config)
-    return tuple(
-        tuple(tracker.update(stamp, dets))
-        for stamp, dets in zip(detections.stamps_ns, detections.detections, strict=True)
-    )
+    """Run the configured tracker over per-frame detections (a fresh tracker per sequence).
+
+    A tracker that needs frames (:func:`rgbd_eval.track.protocol.needs_frame`) gets them
+    from ``recording``, read again (ConfigError when it is not given).
+    """
+    tracker = create_tracker(config)
+    pairs = zip(detections.stamps_ns, detections.detections, strict=True)
+    if not needs_frame(config):
+        return tuple(tuple(tracker.update(stamp, dets)) for stamp, dets in pairs)
+    if recording is None:
+        raise ConfigError(
+            f"tracker {config.tracker.name!r} reads frames: replaying it needs the recording"
+        )
+    out = []
+    for (stamp, dets), frame in zip(pairs, recording.frames(), strict=True):
+        if frame.stamp_ns != stamp:
+            raise InputError(recording.path, f"frame {frame.index} changed since it was detected")
+        out.append(tuple(tracker.update(stamp, dets, frame)))
+    return tuple(out)
 
 
 def detect_and_track(
-    recording: Recording, config: RunConfig, progress: Progress | None = None
+    recording: Recording,
+    config: RunConfig,
+    progress: Progress | None = None,
+    keep_appearance: bool = False,
 ) -> tuple[SequenceDetections, tuple[tuple[TrackOutput, ...], ...]]:
     """Detect and track frame by frame; the detections kept lose their appearance descriptors.
 
     The results equal :func:`detect_sequence` then :func:`track_sequence` (detector
     and tracker are independent), but the descriptors (2 KB per detection for
     basso2012's colour histogram) are dropped once the tracker has seen them, so
-    memory grows only by the small per-frame records (stamps, boxes, tracks).
+    memory grows only by the small per-frame records (stamps, boxes, tracks);
+    ``keep_appearance`` keeps them (for a replay of the tracker, as ``bench`` does).
+    ``seconds`` of the result hold ``read``, ``detect`` and ``track`` and, as
+    ``stage.<name>``, the detector's and tracker's own stages (the rest of their
+    calls as ``stage.detections`` and ``stage.track``): the figures of ``bench``.
     """
     seconds = {"read": 0.0, "detect": 0.0, "track": 0.0}
-    tracker = create_tracker(config.method, config)
+    stages: dict[str, float] = {}
+    tracker = create_tracker(config)
+    with_frame = needs_frame(config)
     stamps: list[int] = []
     per_frame: list[tuple[Detection, ...]] = []
     tracks: list[tuple[TrackOutput, ...]] = []
-    for stamp, dets in _detect_frames(recording, config, seconds):
+    for frame, dets in _detect_frames(recording, config, seconds, stages):
         start = time.perf_counter()
-        tracks.append(tuple(tracker.update(stamp, dets)))
-        seconds["track"] += time.perf_counter() - start
-        stamps.append(stamp)
-        per_frame.append(tuple(replace(d, appearance=None) for d in dets))
+        if with_frame:
+            tracks.append(tuple(tracker.update(frame.stamp_ns, dets, frame)))
+        else:
+            tracks.append(tuple(tracker.update(frame.stamp_ns, dets)))
+        spent = time.perf_counter() - start
+        seconds["track"] += spent
+        _add_stages(stages, tracker.last_timings, TRACK_REST, spent)
+        stamps.append(frame.stamp_ns)
+        per_frame.append(
+            dets if keep_appearance else tuple(replace(d, appearance=None) for d in dets)
+        )
         if progress is not None:
             progress(len(per_frame), len(recording))
-    return SequenceDetections(tuple(stamps), tuple(per_frame), seconds), tuple(tracks)
+    sequence = SequenceDetections(tuple(stamps), tuple(per_frame), _stage_seconds(seconds, stages))
+    return sequence, tuple(tracks)
 
 
 def match_ground_truth(
@@ -192,7 +251,7 @@ def run_sequence(
     """Read, detect, track and (when ground truth exists) score one recording."""
     path = Path(path)
     start = time.perf_counter()
-    recording = open_recording(path, config.io)
+    recording = open_for(path, config)
     index_s = time.perf_counter() - start
     gt = find_ground_truth(path, recording, gt_path)
     detections, tracks = detect_and_track(recording, config, progress)

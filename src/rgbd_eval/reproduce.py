@@ -17,12 +17,12 @@ from typing import TYPE_CHECKING, Any
 import yaml
 
 from rgbd_eval.cache import DetectionCache, detection_key
-from rgbd_eval.config import RunConfig, build_config, load_config, repo_root
+from rgbd_eval.config import RunConfig, build_config, config_dir, load_config
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import TaskError
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.methods.basso2012 import SCENARIOS
 from rgbd_eval.metrics import Counts, summarize, total
-from rgbd_eval.pipeline import detect_sequence, sequence_name, track_sequence
+from rgbd_eval.pipeline import detect_sequence, open_for, sequence_name, track_sequence
 from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import TrackStatus, Visibility
@@ -30,14 +30,6 @@ from rgbd_eval.types import TrackStatus, Visibility
 if TYPE_CHECKING:
     from distributed import Client
 
-SCENARIOS = (
-    "static_simple",
-    "static_complex",
-    "static_obstacles",
-    "moving_simple",
-    "moving_complex",
-    "moving_obstacles",
-)
 MEMORY_SECONDS = (0.0, 3.0, 30.0)  # Figure 7.7
 VOXEL_SIZES = (0.04, 0.06, 0.08, 0.10, 0.12, 0.15)  # Figure 7.9
 THRESHOLDS = (0.5, 0.0, -0.5, -1.0, -1.5, -1.75, -2.0, -2.5, -3.0)  # Table 7.6
@@ -47,9 +39,7 @@ Progress = Callable[[str], None]
 
 def paper_values(path: Path | None = None) -> dict[str, Any]:
     """The published numbers (``configs/papers/basso2012.yaml``)."""
-    data = yaml.safe_load(
-        (path or repo_root() / "configs" / "papers" / "basso2012.yaml").read_text()
-    )
+    data = yaml.safe_load((path or config_dir() / "papers" / "basso2012.yaml").read_text())
     if not isinstance(data, dict):
         raise ValueError("paper values file must hold a mapping")
     return data
@@ -116,7 +106,7 @@ def track_lengths(config: RunConfig, recording: Path, digest: str, cache: Path |
     key = detection_key(digest, config)
     detections = store.load(key)
     if detections is None:  # not cached (or the file changed since): detect now
-        detections = detect_sequence(open_recording(recording, config.io), config)
+        detections = detect_sequence(open_for(recording, config), config)
         store.store(key, detections)
     frames: dict[int, int] = {}
     for tracks in track_sequence(detections, config):
@@ -135,7 +125,7 @@ def voxel_timing(
     (0.06 / v)^2 from Table 5.1's values for 0.06 m.
     """
     out: dict[float, dict[str, float]] = {}
-    rec = open_recording(recording)
+    rec = open_for(recording, build_config(base))
     for v in VOXEL_SIZES:
         scale = (0.06 / v) ** 2
         cfg = build_config(
@@ -146,7 +136,7 @@ def voxel_timing(
                 ("detector.max_points", max(2, round(600 * scale))),
             ],
         )
-        detector = create_detector(cfg.method, cfg)
+        detector = create_detector(cfg)
         sums: dict[str, float] = {}
         n = 0
         start = time.perf_counter()

@@ -16,7 +16,9 @@ Results do not depend on the number of workers or on completion order: the
 records are assembled in grid order, and tracking always starts from the
 detections as the cache encodes them (a fresh detection is round-tripped
 through :func:`rgbd_eval.cache.encode` first), so a cache hit and a miss
-track the very same numbers.
+track the very same numbers. A tracker that reads frames (``needs_frame``) gets
+them by reading the recording again in its track task; the others replay the
+detections alone.
 """
 
 from __future__ import annotations
@@ -41,7 +43,6 @@ from rgbd_eval.cache import (
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
 from rgbd_eval.engine import ClusterSpec, connect, killed_worker_message
 from rgbd_eval.errors import ClusterError, ConfigError, InputError, RgbdEvalError, ScoringError
-from rgbd_eval.io.reader import open_recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,
@@ -49,11 +50,13 @@ from rgbd_eval.pipeline import (
     detect_sequence,
     ground_truth_file,
     match_ground_truth,
+    open_for,
     score_sequence,
     sequence_name,
     track_sequence,
 )
 from rgbd_eval.report import file_digest
+from rgbd_eval.track.protocol import needs_frame
 
 if TYPE_CHECKING:
     from distributed import Client, Future
@@ -183,6 +186,7 @@ class _Failed:
 class _Prepared:
     """Prepare-task output for one sequence and one detector config."""
 
+    path: Path
     key: str
     detections: SequenceDetections
     ground_truth: GroundTruthMatch
@@ -230,7 +234,7 @@ def _prepare(
         gt = ground_truth_file(path, gt_path)
         if detections is None or gt is None:
             # The index pass reads every image message: only when detecting or for a ground-truth topic.
-            recording = open_recording(path, config.io)
+            recording = open_for(path, config)
             if gt is None:
                 gt = recording.ground_truth_topic
             if gt is None:
@@ -245,7 +249,7 @@ def _prepare(
         matched = match_ground_truth(gt, detections.stamps_ns, config)
     except RgbdEvalError as err:
         return _Failed(" ".join(str(err).split()), err.exit_code)
-    return _Prepared(key, detections, matched, time.perf_counter() - start, hit, rejected)
+    return _Prepared(path, key, detections, matched, time.perf_counter() - start, hit, rejected)
 
 
 def _brief(prepared: _Prepared | _Failed) -> _Brief:
@@ -260,7 +264,9 @@ def _track(prepared: _Prepared | _Failed, config: RunConfig) -> tuple[Counts, fl
         return prepared
     start = time.perf_counter()
     try:
-        tracks = track_sequence(prepared.detections, config)
+        # A tracker that reads frames replays them from the recording, read again.
+        recording = open_for(prepared.path, config) if needs_frame(config) else None
+        tracks = track_sequence(prepared.detections, config, recording)
         scores = score_sequence(prepared.ground_truth, tracks, config)
     except RgbdEvalError as err:
         return _Failed(" ".join(str(err).split()), err.exit_code)

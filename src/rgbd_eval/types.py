@@ -15,7 +15,9 @@ Conventions (used everywhere in the package):
 from __future__ import annotations
 
 import enum
+from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -247,25 +249,106 @@ class Box3D:
 
 
 @dataclass(frozen=True, eq=False)
-class Frame:
-    """One synchronised instant of a recording.
+class Stream:
+    """One image of a frame: a role's image with its camera, stamp and pose.
 
-    ``camera_pose`` is ``world_T_depth_optical``: it maps depth-camera optical-frame
-    points to the world frame. ``depth_to_rgb`` is ``rgb_optical_T_depth_optical``.
-    ``world_frame`` names the world frame; ``has_odometry`` is False when the
-    recording has no odometry and the world frame is the camera body frame.
+    ``encoding`` says what the pixels are: ``rgb8`` (``HxWx3 uint8``), ``mono8``/``mono16``
+    (thermal or grey, raw counts) or ``depth`` (``float32`` metres, NaN invalid).
+    ``pose`` is ``world_T_optical`` of this camera at the frame stamp.
+    """
+
+    image: NDArray[Any]
+    encoding: str
+    camera: CameraModel
+    stamp_ns: int
+    pose: Pose = field(default_factory=lambda: OPTICAL_TO_BODY)
+
+
+@dataclass(frozen=True, eq=False)
+class Frame:
+    """One synchronised instant of a recording: named streams (``colour``, ``depth``,
+    ``depth_2``, ``thermal``, ``left``, ``right``; see :data:`rgbd_eval.plugins.ROLES`).
+
+    ``stamp_ns`` is the stamp of the reference stream (the first the method reads).
+    ``camera_pose`` is ``world_T_optical`` of the primary geometry camera (``depth``
+    when present): it maps its optical-frame points to the world frame.
+    ``depth_to_rgb`` is ``colour_optical_T_depth_optical`` (identity when the depth is
+    registered to colour, or either is absent). ``world_frame`` names the world frame;
+    ``has_odometry`` is False when the recording has no odometry and the world frame
+    is the camera body frame.
     """
 
     index: int
     stamp_ns: int
-    rgb: NDArray[np.uint8]
-    depth: NDArray[np.float32]
-    rgb_camera: CameraModel
-    depth_camera: CameraModel
+    streams: Mapping[str, Stream]
     depth_to_rgb: Pose = field(default_factory=Pose.identity)
     camera_pose: Pose = field(default_factory=lambda: OPTICAL_TO_BODY)
     world_frame: str = "camera"
     has_odometry: bool = False
+
+    @staticmethod
+    def rgbd(
+        index: int,
+        stamp_ns: int,
+        rgb: NDArray[np.uint8],
+        depth: NDArray[np.float32],
+        rgb_camera: CameraModel,
+        depth_camera: CameraModel,
+        depth_to_rgb: Pose | None = None,
+        camera_pose: Pose = OPTICAL_TO_BODY,
+        world_frame: str = "camera",
+        has_odometry: bool = False,
+    ) -> Frame:
+        """A colour + depth frame, both at ``stamp_ns`` (the common case, and tests)."""
+        d2r = depth_to_rgb or Pose.identity()
+        colour_pose = camera_pose.compose(d2r.inverse()) if depth_to_rgb else camera_pose
+        return Frame(
+            index=index,
+            stamp_ns=stamp_ns,
+            streams={
+                "colour": Stream(rgb, "rgb8", rgb_camera, stamp_ns, colour_pose),
+                "depth": Stream(depth, "depth", depth_camera, stamp_ns, camera_pose),
+            },
+            depth_to_rgb=d2r,
+            camera_pose=camera_pose,
+            world_frame=world_frame,
+            has_odometry=has_odometry,
+        )
+
+    def stream(self, role: str) -> Stream:
+        """The stream of ``role``; KeyError naming the roles present when absent."""
+        try:
+            return self.streams[role]
+        except KeyError:
+            raise KeyError(
+                f"frame {self.index} has no {role!r} stream (has: {', '.join(self.streams)})"
+            ) from None
+
+    @property
+    def rgb(self) -> NDArray[np.uint8]:
+        """The colour image (``HxWx3 uint8``, RGB order)."""
+        image: NDArray[np.uint8] = self.stream("colour").image
+        return image
+
+    @property
+    def depth(self) -> NDArray[np.float32]:
+        """The (first) depth image in metres, NaN invalid."""
+        image: NDArray[np.float32] = self.stream("depth").image
+        return image
+
+    @property
+    def rgb_camera(self) -> CameraModel:
+        return self.stream("colour").camera
+
+    @property
+    def depth_camera(self) -> CameraModel:
+        return self.stream("depth").camera
+
+    def depth_streams(self) -> list[tuple[str, Stream]]:
+        """Every depth camera's stream: ``depth``, ``depth_2``, ... in that order."""
+        roles = [r for r in self.streams if r == "depth" or r.startswith("depth_")]
+        roles.sort(key=lambda r: 1 if r == "depth" else int(r.rpartition("_")[2]))
+        return [(r, self.streams[r]) for r in roles]
 
 
 @dataclass(frozen=True, eq=False)

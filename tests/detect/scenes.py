@@ -163,7 +163,7 @@ def render(
         rng = np.random.default_rng(noise_seed + index)
         depth = depth + rng.normal(0.0, 1.0, depth.shape) * DEPTH_NOISE_K * depth**2
     rgb = _cast_rgb(rc, pose, RGB_CAMERA, colours, floor_id)
-    return Frame(
+    return Frame.rgbd(
         index=index,
         stamp_ns=index * 33_333_333,
         rgb=rgb,

@@ -11,10 +11,13 @@ import dataclasses
 import numpy as np
 import pytest
 
-from rgbd_eval.config import DetectorConfig, GroundMode, RunConfig
-from rgbd_eval.detect import create_detector, known_detectors
+from rgbd_eval.config import build_config
+from rgbd_eval.detect import create_detector
 from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
+from rgbd_eval.detect.basso2012_config import GroundMode
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.plugins import known
 from rgbd_eval.types import OPTICAL_TO_BODY, Detection, Frame
 
 from .scenes import Block, Person, Scene, camera_pose, render
@@ -265,7 +268,7 @@ def test_plane_is_kept_when_the_floor_is_not_seen() -> None:
     # Next frame: every pixel below the horizon invalid (floor unseen).
     depth = frame.depth.copy()
     depth[depth.shape[0] // 2 + 2 :, :] = np.nan
-    det.detect(dataclasses.replace(frame, depth=depth, index=1))
+    det.detect(dataclasses.replace(_with_images(frame, frame.rgb, depth), index=1))
     np.testing.assert_array_equal(det.ground_plane, before)
     assert det.ground.inliers < CFG.ground_min_points
 
@@ -316,9 +319,21 @@ def test_deterministic_and_timed() -> None:
 def test_bad_frame_raises() -> None:
     frame = render(Scene(), camera_pose(height=1.0))
     with pytest.raises(ValueError, match="depth image"):
-        Basso2012Detector(CFG).detect(dataclasses.replace(frame, depth=frame.depth[:, :10]))
+        Basso2012Detector(CFG).detect(_with_images(frame, frame.rgb, frame.depth[:, :10]))
     with pytest.raises(ValueError, match="rgb image"):
-        Basso2012Detector(CFG).detect(dataclasses.replace(frame, rgb=frame.rgb[..., 0]))
+        Basso2012Detector(CFG).detect(_with_images(frame, frame.rgb[..., 0], frame.depth))
+
+
+def _with_images(frame: Frame, rgb: np.ndarray, depth: np.ndarray) -> Frame:
+    return Frame.rgbd(
+        frame.index,
+        frame.stamp_ns,
+        rgb,
+        depth,
+        frame.rgb_camera,
+        frame.depth_camera,
+        camera_pose=frame.camera_pose,
+    )
 
 
 def test_empty_scene_gives_no_detections() -> None:
@@ -326,8 +341,8 @@ def test_empty_scene_gives_no_detections() -> None:
 
 
 def test_registry() -> None:
-    assert "basso2012" in known_detectors()
-    det = create_detector("basso2012", RunConfig())
+    assert "basso2012" in known("detectors")
+    det = create_detector(build_config())
     assert isinstance(det, Basso2012Detector)
     with pytest.raises(ConfigError, match=r"unknown detector 'nope' \(known: .*basso2012"):
-        create_detector("nope", RunConfig())
+        build_config({"detector": {"name": "nope"}})

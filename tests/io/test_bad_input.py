@@ -70,9 +70,12 @@ def test_no_depth_topic(tmp_path: Path) -> None:
     path = tmp_path / "rgb_only.mcap"
     with RecordingWriter(path, "mcap") as w:
         w.write_rgb(T0, rgb_image(0), RGB_CAM)
-    code, out = inspect(path)
+    code, out = inspect(path, "--method", "basso2012")
     assert code == 3
-    assert_one_line_error(out, "rgb_only.mcap", "no depth image topic found")
+    assert_one_line_error(out, "rgb_only.mcap", "no depth image topic found", "--topic depth=/name")
+    code, out = inspect(path)  # without a method, inspect shows whatever streams there are
+    assert code == 0, out
+    assert "colour" in out
 
 
 def test_several_rgb_topics_are_listed(make_recording: Callable[..., Path]) -> None:
@@ -91,12 +94,12 @@ def test_several_rgb_topics_are_listed(make_recording: Callable[..., Path]) -> N
     assert code == 3
     assert_one_line_error(
         out,
-        "several RGB image topics",
+        "several colour image topics",
         "/camera/rgb/image_color",
         "/camera2/image_color",
-        "--rgb-topic",
+        "--topic colour=/name",
     )
-    code, out = inspect(extra, "--rgb-topic", "/camera/rgb/image_color")
+    code, out = inspect(extra, "--topic", "colour=/camera/rgb/image_color")
     assert code == 0, out
 
 
@@ -175,9 +178,12 @@ def test_broken_tf_chain(make_recording: Callable[..., Path]) -> None:
 
 def test_bad_option_value_is_a_config_error(make_recording: Callable[..., Path]) -> None:
     path = make_recording("mcap", Spec(n=2))
-    code, out = inspect(path, "--max-sync-gap-ms", "-5")
+    code, out = inspect(path, "--set", "io.max_sync_gap_ms=-5")
     assert code == 4
-    assert_one_line_error(out, "max_sync_gap_ms")
+    assert_one_line_error(out, "--set io.max_sync_gap_ms=-5", "max_sync_gap_ms")
+    code, out = inspect(path, "--topic", "sonar=/x")
+    assert code == 4
+    assert_one_line_error(out, "unknown topic role 'sonar'")
 
 
 def test_compressed_rgb_garbage(tmp_path: Path) -> None:

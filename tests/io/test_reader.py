@@ -126,6 +126,7 @@ def test_sync_drops_and_counts_unpaired(make_recording: Callable[..., Path]) -> 
     rec = open_recording(make_recording("mcap", spec))
     s = rec.info.sync
     # rgb 0,1,3 pair (1 ms); rgb 4 (t0+133ms) and depth t0+166ms-1ms: 32.3 ms > 20 ms -> unpaired.
-    assert s.paired == 3 and s.rgb_dropped == 2 and s.depth_dropped == 2
+    assert s.frames == 3 and s.reference == "colour"
+    assert [(x.role, x.dropped) for x in s.streams] == [("colour", 2), ("depth", 2)]
     assert s.worst_gap_ms == pytest.approx(1.0)
     assert [f.stamp_ns for f in rec.frames()] == [rgb[0], rgb[1], rgb[3]]

@@ -24,7 +24,7 @@ from scipy.linalg import blas
 
 import rgbd_eval.track.basso2012 as basso2012
 import rgbd_eval.track.boosting as boosting
-from rgbd_eval.config import RunConfig, TrackerConfig
+from rgbd_eval.config import build_config
 from rgbd_eval.track import create_tracker
 from rgbd_eval.track.boosting import (
     _INITIAL_WEIGHT,
@@ -378,7 +378,7 @@ def _with_gaps(stream: list[tuple[int, list[Detection]]]) -> list[tuple[int, lis
 
 
 def _run(stream: list[tuple[int, list[Detection]]]) -> list[list[TrackOutput]]:
-    tracker = create_tracker("basso2012", RunConfig(tracker=TrackerConfig(classifier=True)))
+    tracker = create_tracker(build_config({"tracker": {"classifier": True}}))
     return [tracker.update(stamp, dets) for stamp, dets in stream]
 
 

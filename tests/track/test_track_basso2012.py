@@ -9,10 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rgbd_eval.config import ClusterSelection, RunConfig, TrackerConfig, build_config
+from rgbd_eval.config import build_config
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.track import create_tracker, known_trackers
+from rgbd_eval.plugins import known
+from rgbd_eval.track import create_tracker
 from rgbd_eval.track.basso2012 import Basso2012Tracker
+from rgbd_eval.track.basso2012_config import ClusterSelection
 from rgbd_eval.track.synthetic import (
     THREE_PEOPLE,
     colour_histogram,
@@ -26,7 +28,7 @@ RED, BLUE = (200.0, 40.0, 40.0), (40.0, 40.0, 200.0)
 
 
 def _tracker(**tracker: object) -> Basso2012Tracker:
-    t = create_tracker("basso2012", RunConfig(tracker=TrackerConfig(**tracker)))
+    t = create_tracker(build_config({"tracker": tracker}))
     assert isinstance(t, Basso2012Tracker)
     return t
 
@@ -49,10 +51,10 @@ def _ids(out: list[TrackOutput]) -> list[int]:
 
 
 def test_registry_creates_basso2012_and_rejects_unknown_names() -> None:
-    assert "basso2012" in known_trackers()
-    assert isinstance(create_tracker("basso2012", RunConfig()), Basso2012Tracker)
+    assert "basso2012" in known("trackers")
+    assert isinstance(create_tracker(build_config()), Basso2012Tracker)
     with pytest.raises(ConfigError, match=r"unknown tracker 'nope' \(known: .*basso2012"):
-        create_tracker("nope", RunConfig())
+        build_config({"tracker": {"name": "nope"}})
 
 
 def test_stamps_must_increase_and_histograms_must_match_bins() -> None:

@@ -9,7 +9,14 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import advance_callback, console, handle_errors, progress_bar
+from rgbd_eval.cli.common import (
+    TopicOption,
+    advance_callback,
+    console,
+    handle_errors,
+    progress_bar,
+    topic_overrides,
+)
 from rgbd_eval.config import load_config
 
 if TYPE_CHECKING:
@@ -26,8 +33,7 @@ STAGE_LABELS = {
     "subclustering": "sub-clustering",
     "features": "features",
     "hog": "HOG",
-    "detections": "detections (rest)",
-    "detect": "detection",
+    "detections": "detector (rest of the call)",
     "track": "tracking",
     "score": "scoring",
     "other": "other (loop)",
@@ -91,7 +97,7 @@ def bench(
         Path | None, typer.Argument(help="recording to time (default: the demo)")
     ] = None,
     method: Annotated[
-        str | None, typer.Option(help="detector/tracker pairing (default: basso2012)")
+        str | None, typer.Option(help="method by name (`rgbd-eval methods`; default: basso2012)")
     ] = None,
     repeat: Annotated[int, typer.Option(help="repeats; figures are medians")] = 3,
     config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
@@ -105,6 +111,7 @@ def bench(
         bool,
         typer.Option("--all-cores", help="do not pin to one CPU (OpenCV may use threads)"),
     ] = False,
+    topics: TopicOption = None,
 ) -> None:
     """Time each pipeline stage on one recording, against the floor of decoding it alone.
 
@@ -114,7 +121,9 @@ def bench(
     from rgbd_eval.cli.run import ensure_demo
 
     config = load_config(
-        config_file, overrides or [], method=method or (None if config_file else "basso2012")
+        config_file,
+        [*(overrides or []), *topic_overrides(topics)],
+        method=method or (None if config_file else "basso2012"),
     )
     target = path if path is not None else ensure_demo()
     if not all_cores:

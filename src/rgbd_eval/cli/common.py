@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import functools
 import sys
-from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ParamSpec, TypeVar
+from collections.abc import Callable, Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -88,6 +89,32 @@ def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
     return wrapper
 
 
+#: ``--topic ROLE=/name`` (repeatable), on every command that reads recordings.
+TopicOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--topic",
+        help="topic of a stream role, e.g. depth=/camera/depth/image_raw (roles: colour, "
+        "depth, depth_2..., thermal, left, right, <role>_info, odometry, ground_truth); repeatable",
+    ),
+]
+ConfigOption = Annotated[Path | None, typer.Option("--config", help="YAML run config")]
+SetOption = Annotated[
+    list[str] | None, typer.Option("--set", help="KEY=VALUE config override, repeatable")
+]
+
+
+def topic_overrides(items: list[str] | None) -> list[str]:
+    """``--topic ROLE=/name`` values as ``--set io.topics.ROLE=/name`` overrides."""
+    out = []
+    for item in items or []:
+        role, sep, topic = item.partition("=")
+        if not sep or not role.strip() or not topic.strip():
+            raise ConfigError(f"--topic {item!r}: expected ROLE=/topic, e.g. depth=/camera/depth")
+        out.append(f"io.topics.{role.strip()}={topic.strip()}")
+    return out
+
+
 def jsonable(value: Any) -> Any:
     """Dataclasses, tuples and enums -> plain JSON values."""
     import dataclasses
@@ -95,7 +122,7 @@ def jsonable(value: Any) -> Any:
 
     if dataclasses.is_dataclass(value) and not isinstance(value, type):
         return {f.name: jsonable(getattr(value, f.name)) for f in dataclasses.fields(value)}
-    if isinstance(value, dict):
+    if isinstance(value, Mapping):
         return {str(k): jsonable(v) for k, v in value.items()}
     if isinstance(value, list | tuple | set):
         return [jsonable(v) for v in value]

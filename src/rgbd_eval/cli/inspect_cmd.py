@@ -3,17 +3,27 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import SCHEMA_VERSION, console, handle_errors, jsonable
-from rgbd_eval.config import IoConfig
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.cli.common import (
+    SCHEMA_VERSION,
+    ConfigOption,
+    SetOption,
+    TopicOption,
+    console,
+    handle_errors,
+    jsonable,
+    topic_overrides,
+)
+from rgbd_eval.config import IoConfig, load_config
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
-from rgbd_eval.io.reader import RecordingInfo, open_recording
+from rgbd_eval.io.reader import ALL_STREAMS, RecordingInfo, open_recording
+from rgbd_eval.plugins import StreamSpec
 
 
 def sidecar_for(path: Path) -> Path | None:
@@ -37,9 +47,14 @@ def gt_summary(gt: GroundTruth | None, source: str | None) -> dict[str, Any] | N
     }
 
 
-def inspect_data(path: Path, io: IoConfig, gt_path: Path | None = None) -> dict[str, Any]:
+def inspect_data(
+    path: Path,
+    io: IoConfig,
+    gt_path: Path | None = None,
+    streams: Sequence[StreamSpec] = ALL_STREAMS,
+) -> dict[str, Any]:
     """Everything ``inspect`` reports, as a JSON-ready dict."""
-    rec = open_recording(path, io)
+    rec = open_recording(path, io, streams)
     info: RecordingInfo = rec.info
     next(iter(rec.frames()))  # decode one frame: encodings and image sizes are checked here
     sidecar = gt_path or sidecar_for(path)
@@ -65,8 +80,13 @@ def _print_human(data: dict[str, Any]) -> None:
         table.add_column(
             col, justify="right" if numeric else "left", overflow="fold", no_wrap=numeric
         )
-    roles = {v: k for k, v in info["selected"].items() if isinstance(v, str)}
-    for t in info["selected"]["tf"]:
+    sel = info["selected"]
+    roles = {t: r for r, t in sel["streams"].items()}
+    roles.update({t: f"{r}_info" for r, t in sel["infos"].items()})
+    for role in ("odometry", "ground_truth"):
+        if sel[role]:
+            roles[sel[role]] = role
+    for t in sel["tf"]:
         roles[t] = "tf"
     for t in info["topics"]:
         rate = f"{t['rate_hz']:.2f}" if t["rate_hz"] else "-"
@@ -74,14 +94,19 @@ def _print_human(data: dict[str, Any]) -> None:
     console.print(table)
     s = info["sync"]
     console.print(
-        f"sync: {s['paired']} pairs of {s['rgb_messages']} RGB / {s['depth_messages']} depth; dropped "
-        f"{s['rgb_dropped']} RGB, {s['depth_dropped']} depth, {s['no_pose_dropped']} without pose; "
-        f"worst gap {s['worst_gap_ms']:.2f} ms (max {s['max_gap_ms']:.1f}), mean {s['mean_gap_ms']:.2f} ms"
+        f"sync: {s['frames']} frames on the {s['reference']} stamps, "
+        f"{s['no_pose_dropped']} dropped without pose (largest gap accepted {s['max_gap_ms']:.1f} ms)"
     )
-    for name in ("rgb_camera", "depth_camera"):
-        c = info[name]
+    for st in s["streams"]:
+        gap = (
+            ""
+            if st["role"] == s["reference"]
+            else (f", worst gap {st['worst_gap_ms']:.2f} ms, mean {st['mean_gap_ms']:.2f} ms")
+        )
+        console.print(f"  {st['role']}: {st['messages']} messages, {st['dropped']} dropped{gap}")
+    for role, c in info["cameras"].items():
         console.print(
-            f"{name}: {c['width']}x{c['height']} fx={c['fx']:.1f} fy={c['fy']:.1f} "
+            f"{role} camera: {c['width']}x{c['height']} fx={c['fx']:.1f} fy={c['fy']:.1f} "
             f"cx={c['cx']:.1f} cy={c['cy']:.1f} frame {c['frame_id']!r}"
         )
     if info["has_odometry"]:
@@ -108,22 +133,25 @@ def inspect(
         bool, typer.Option("--json", help="machine-readable JSON on stdout")
     ] = False,
     gt: Annotated[Path | None, typer.Option("--gt", help="ground-truth file (CSV or KTP)")] = None,
-    rgb_topic: Annotated[str | None, typer.Option(help="RGB image topic")] = None,
-    depth_topic: Annotated[str | None, typer.Option(help="depth image topic")] = None,
-    odom_topic: Annotated[str | None, typer.Option(help="odometry topic")] = None,
-    max_sync_gap_ms: Annotated[float, typer.Option(help="largest RGB/depth stamp gap")] = 20.0,
+    topics: TopicOption = None,
+    method: Annotated[
+        str | None,
+        typer.Option(help="choose the streams this method reads (default: every stream found)"),
+    ] = None,
+    config_file: ConfigOption = None,
+    overrides: SetOption = None,
 ) -> None:
     """Topics, rates, chosen streams, sync quality, tf chain and ground truth of a recording."""
-    try:
-        io = IoConfig(
-            rgb_topic=rgb_topic,
-            depth_topic=depth_topic,
-            odom_topic=odom_topic,
-            max_sync_gap_ms=max_sync_gap_ms,
-        )
-    except ValueError as err:
-        raise ConfigError(" ".join(str(err).split())) from err
-    data = inspect_data(path, io, gt)
+    from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
+
+    sets = [*(overrides or []), *topic_overrides(topics)]
+    config = load_config(config_file, sets, method=method or (None if config_file else "basso2012"))
+    streams = (
+        streams_of(detector_spec(config.detector.name), tracker_spec(config.tracker.name))
+        if method or config_file
+        else ALL_STREAMS
+    )
+    data = inspect_data(path, config.io, gt, streams)
     if json_out:
         typer.echo(json.dumps(data, indent=2))
     else:

@@ -8,6 +8,7 @@ from rgbd_eval import __version__
 from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.inspect_cmd import inspect
+from rgbd_eval.cli.methods_cmd import methods
 from rgbd_eval.cli.reproduce_cmd import reproduce
 from rgbd_eval.cli.run import run
 from rgbd_eval.cli.sweep_cmd import sweep
@@ -28,6 +29,7 @@ app.command("compare")(compare)
 app.command("synth")(synth)
 app.command("reproduce")(reproduce)
 app.command("bench")(bench)
+app.command("methods")(methods)
 
 
 def _version(value: bool) -> None:

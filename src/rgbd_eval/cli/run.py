@@ -12,13 +12,15 @@ from rich.table import Table
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
+    TopicOption,
     advance_callback,
     console,
     err_console,
     handle_errors,
     progress_bar,
+    topic_overrides,
 )
-from rgbd_eval.config import RunConfig, load_config, repo_root
+from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.errors import InputError
 
 if TYPE_CHECKING:
@@ -28,7 +30,9 @@ RECORDING_SUFFIXES = (".bag", ".mcap", ".db3")
 
 
 def default_demo() -> Path:
-    return repo_root() / "datasets" / "demo.mcap"
+    from rgbd_eval.sim.synth import DEMO, dataset_path
+
+    return dataset_path(DEMO)
 
 
 def expand_inputs(paths: list[Path]) -> list[Path]:
@@ -94,7 +98,7 @@ def run(
         typer.Argument(help="recordings or folders of recordings (default: the demo)"),
     ] = None,
     method: Annotated[
-        str | None, typer.Option(help="detector/tracker pairing (default: basso2012)")
+        str | None, typer.Option(help="method by name (`rgbd-eval methods`; default: basso2012)")
     ] = None,
     gt: Annotated[
         Path | None, typer.Option(help="ground-truth file (CSV or KTP) for a single recording")
@@ -115,6 +119,7 @@ def run(
     json_out: Annotated[
         bool, typer.Option("--json", help="print report.json on stdout instead of a table")
     ] = False,
+    topics: TopicOption = None,
     cluster: Annotated[
         str | None,
         typer.Option(help=f"{CLUSTER_HELP} (default: in this process for one recording)"),
@@ -124,7 +129,7 @@ def run(
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
     from rgbd_eval.report import write_run
 
-    sets = list(overrides or [])
+    sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:
         sets.append(f"evaluation.gating={gating}")
     if threshold is not None:

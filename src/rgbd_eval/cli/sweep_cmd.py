@@ -15,11 +15,13 @@ from rgbd_eval.cli.common import (
     CACHE_MODE_HELP,
     CLUSTER_HELP,
     SCHEMA_VERSION,
+    TopicOption,
     console,
     err_console,
     handle_errors,
     parse_cache_mode,
     progress_bar,
+    topic_overrides,
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError, TaskError
@@ -99,6 +101,7 @@ def sweep(
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
     cache_mode: Annotated[str, typer.Option(help=CACHE_MODE_HELP)] = "shared",
+    topics: TopicOption = None,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
@@ -118,7 +121,7 @@ def sweep(
 
     specs: list[SweepParam] = [parse_param(p) for p in params or []]
     names = list(dataset or [])
-    fixed = list(overrides or [])
+    fixed = [*(overrides or []), *topic_overrides(topics)]
     if file is not None:
         data = load_yaml(file)
         unknown = set(data) - {"params", "datasets", "set"}

@@ -22,7 +22,7 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import DetectorConfig, RunConfig
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -52,7 +52,7 @@ from rgbd_eval.detect.features import (
 from rgbd_eval.detect.ground import GroundPlaneEstimator
 from rgbd_eval.detect.hog import hog_confidences
 from rgbd_eval.detect.plane import signed_heights
-from rgbd_eval.detect.protocol import Detector, register_detector
+from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Box2D, Box3D, CameraModel, Detection, Frame
 
 FloatArray = NDArray[np.float64]
@@ -95,9 +95,11 @@ class _Candidate:
 class Basso2012Detector:
     """The reference detector of seed 000 (chapter 5), with head-based sub-clustering."""
 
-    def __init__(self, config: DetectorConfig) -> None:
-        if not isinstance(config, DetectorConfig):
-            raise TypeError(f"config must be a DetectorConfig, got {type(config).__name__}")
+    def __init__(self, config: Basso2012DetectorConfig) -> None:
+        if not isinstance(config, Basso2012DetectorConfig):
+            raise TypeError(
+                f"config must be a Basso2012DetectorConfig, got {type(config).__name__}"
+            )
         self.config = config
         self.ground = GroundPlaneEstimator(config)
         self.last_timings: dict[str, float] = dict.fromkeys(STAGES, 0.0)
@@ -366,7 +368,25 @@ def _check_frame(frame: Frame) -> None:
         )
 
 
-@register_detector("basso2012")
-def create_basso2012(config: RunConfig) -> Detector:
-    """Registry factory: the basso2012 detector from ``config.detector``."""
-    return Basso2012Detector(config.detector)
+def _contract(config: Basso2012DetectorConfig) -> DetectionContract:
+    """Ground positions quantised by the voxel grid, RGB boxes, a 3D colour histogram (6.2.2)."""
+    return DetectionContract(
+        world_position=True,
+        box2d=True,
+        appearance="rgb_histogram",
+        appearance_size=config.histogram_bins**3,
+        position_resolution_m=config.voxel_size,
+    )
+
+
+SPEC = register_detector(
+    DetectorSpec(
+        name="basso2012",
+        config_model=Basso2012DetectorConfig,
+        factory=Basso2012Detector,
+        streams=(StreamSpec("colour"), StreamSpec("depth")),
+        contract=_contract,
+        stages=STAGES,
+        summary="voxel grid, ground plane, clusters + head sub-clustering, HOG (seed 000, ch. 5)",
+    )
+)

@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from rgbd_eval.config import DetectorConfig, GroundMode
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig, GroundMode
 from rgbd_eval.detect.plane import (
     fit_plane_least_squares,
     normalise_plane,
@@ -107,7 +107,7 @@ def move_plane(plane: FloatArray, old_T_new: Pose) -> FloatArray:
 class GroundPlaneEstimator:
     """Holds the plane from frame to frame; one instance per sequence."""
 
-    def __init__(self, config: DetectorConfig) -> None:
+    def __init__(self, config: Basso2012DetectorConfig) -> None:
         self._config = config
         self.plane: FloatArray | None = None
         self.inliers = 0

@@ -1,68 +1,41 @@
-"""The detector strategy protocol and its name registry.
+"""The detector strategy protocol.
 
 A detector turns one :class:`~rgbd_eval.types.Frame` into world-frame
 :class:`~rgbd_eval.types.Detection` s. It may keep state from frame to frame
 (basso2012 keeps its ground plane), so feed it the frames of one sequence in
 order and create a fresh detector per sequence; given the same frames in the
 same order it must return the same detections, bit for bit.
+
+Detectors register with :func:`rgbd_eval.plugins.register_detector` (name, config
+model, factory, the streams they read, their detection contract, their stages).
+Stage timing is part of the protocol: after each call, ``last_timings`` holds the
+seconds of each named stage (empty when the detector does not split its work), so
+``bench`` lists any detector's stages.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
-from typing import Protocol, runtime_checkable
+from collections.abc import Mapping
+from typing import Protocol
 
 from rgbd_eval.config import RunConfig
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.plugins import detector_spec
 from rgbd_eval.types import Detection, Frame
 
 
-@runtime_checkable
 class Detector(Protocol):
     """Frames in, detections (world frame) out."""
+
+    @property
+    def last_timings(self) -> Mapping[str, float]:
+        """Seconds of each stage of the last :meth:`detect` call (may be empty)."""
+        ...
 
     def detect(self, frame: Frame) -> list[Detection]:
         """Detect the people in one frame."""
         ...
 
 
-#: Builds a detector from a run config.
-DetectorFactory = Callable[[RunConfig], Detector]
-
-_REGISTRY: dict[str, DetectorFactory] = {}
-
-
-def register_detector(name: str) -> Callable[[DetectorFactory], DetectorFactory]:
-    """Class/function decorator registering a detector factory under ``name``."""
-    if not name or not name.strip():
-        raise ValueError(f"detector name must be a non-empty string, got {name!r}")
-
-    def decorate(factory: DetectorFactory) -> DetectorFactory:
-        existing = _REGISTRY.get(name)
-        if existing is not None and existing is not factory:
-            raise ValueError(f"detector name {name!r} is already registered to {existing!r}")
-        _REGISTRY[name] = factory
-        return factory
-
-    return decorate
-
-
-def known_detectors() -> list[str]:
-    """The registered detector names, sorted."""
-    _load_builtin_detectors()
-    return sorted(_REGISTRY)
-
-
-def create_detector(name: str, config: RunConfig) -> Detector:
-    """A new detector by name; :class:`ConfigError` for an unknown name."""
-    _load_builtin_detectors()
-    factory = _REGISTRY.get(name)
-    if factory is None:
-        known = ", ".join(sorted(_REGISTRY)) or "none"
-        raise ConfigError(f"unknown detector {name!r} (known: {known})")
-    return factory(config)
-
-
-def _load_builtin_detectors() -> None:
-    """Import the modules whose import registers the built-in detectors."""
-    from rgbd_eval.detect import basso2012  # noqa: F401
+def create_detector(config: RunConfig) -> Detector:
+    """A new detector for ``config.detector`` (ConfigError for an unknown name)."""
+    return detector_spec(config.detector.name).factory(config.detector)

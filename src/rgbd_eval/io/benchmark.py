@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,7 +12,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 
 from rgbd_eval.config import IoConfig
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.reader import RGBD_STREAMS, open_recording
+from rgbd_eval.plugins import StreamSpec
 
 
 @dataclass(frozen=True)
@@ -54,14 +56,16 @@ def _raw_floor(path: Path, topics: set[str]) -> tuple[float, str]:
     return time.perf_counter() - start, "rosbags AnyReader"
 
 
-def time_read(path: Path, io: IoConfig | None = None) -> ReadTimings:
+def time_read(
+    path: Path, io: IoConfig | None = None, streams: Sequence[StreamSpec] = RGBD_STREAMS
+) -> ReadTimings:
     """Index + decode every frame of ``path``, and the raw floor for the same image topics."""
     path = Path(path)
     start = time.perf_counter()
-    rec = open_recording(path, io)
+    rec = open_recording(path, io, streams)
     index_s = time.perf_counter() - start
     start = time.perf_counter()
     n = sum(1 for _ in rec.frames())
     frames_s = time.perf_counter() - start
-    floor_s, floor_reader = _raw_floor(path, {rec.info.selected.rgb, rec.info.selected.depth})
+    floor_s, floor_reader = _raw_floor(path, set(rec.info.selected.streams.values()))
     return ReadTimings(n, index_s, frames_s, floor_s, floor_reader)

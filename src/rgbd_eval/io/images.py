@@ -20,6 +20,8 @@ from numpy.typing import NDArray
 
 COLOR_ENCODINGS = ("rgb8", "bgr8", "rgba8", "bgra8", "mono8")
 DEPTH_ENCODINGS = ("16UC1", "mono16", "32FC1")
+#: Single-channel encodings of thermal and grey cameras (raw counts).
+MONO_ENCODINGS = ("mono8", "mono16", "16UC1")
 _COMPRESSED_DEPTH_HEADER = struct.Struct("<iff")
 #: Quantisation of 32FC1 compressedDepth: depth_quantization 100, depth_max 10 m.
 _DEPTH_Z0 = 100.0
@@ -93,6 +95,24 @@ def decode_color(msg: Any) -> NDArray[np.uint8]:
     if conversion is not None:
         return np.asarray(cv2.cvtColor(arr, conversion), dtype=np.uint8)
     return np.ascontiguousarray(arr[..., :3])
+
+
+def decode_mono(msg: Any) -> NDArray[Any]:
+    """Decode a single-channel ``Image`` (mono8, mono16/16UC1) or PNG/JPEG ``CompressedImage``
+    to its raw counts (``uint8`` or ``uint16``): thermal and grey cameras."""
+    if hasattr(msg, "format"):
+        buf = np.asarray(msg.data, dtype=np.uint8)
+        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+        if img is None:
+            raise ImageFormatError(f"compressed image ({msg.format!r}) could not be decoded")
+        if img.ndim == 3:
+            img = cv2.cvtColor(img, cv2.COLOR_BGR2GRAY)
+        return np.asarray(img)
+    if msg.encoding not in MONO_ENCODINGS:
+        raise ImageFormatError(
+            f"expected a single-channel encoding ({', '.join(MONO_ENCODINGS)}), got {msg.encoding!r}"
+        )
+    return np.ascontiguousarray(image_array(msg))
 
 
 def _depth_from_array(arr: NDArray[Any]) -> NDArray[np.float32]:

@@ -8,17 +8,20 @@ Reading takes two passes, so memory stays flat in the sequence length:
 
 1. *Index pass* (:func:`open_recording`): the small messages (CameraInfo,
    odometry, tf, ground truth) are decoded; of the image topics only the header
-   stamps are parsed from the raw bytes. This gives topic selection, the
-   RGB/depth pairing, the tf buffer and every frame's camera pose.
+   stamps are parsed from the raw bytes. This gives the topic of each stream role
+   (colour, depth, depth_2, ..., thermal, left, right: chosen by ``io.topics`` or,
+   where unambiguous, by message type), the pairing of every stream with the
+   reference stream, the tf buffer and every frame's camera poses.
 2. *Frame pass* (:meth:`Recording.frames`): image messages are decoded only
-   when they belong to a pair, and each frame is yielded as soon as both halves
-   have been read.
+   when they belong to a frame, and each frame is yielded as soon as all its
+   streams have been read.
 """
 
 from __future__ import annotations
 
+import math
 import struct
-from collections.abc import Iterator
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -47,9 +50,21 @@ from rgbd_eval.io.messages import (
 from rgbd_eval.io.source import READ_ERRORS, MessageSource, open_source
 from rgbd_eval.io.sync import Pairing, first_non_increasing, pair_nearest
 from rgbd_eval.io.tf import TfBuffer, TransformLookupError
-from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Frame, Pose
+from rgbd_eval.plugins import StreamSpec, role_kind
+from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Frame, Pose, Stream
 
 _IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+
+#: The streams read when a caller names none: colour and depth (the RGB-D methods).
+RGBD_STREAMS = (StreamSpec("colour"), StreamSpec("depth"))
+#: Every role, none required: what ``inspect`` shows.
+ALL_STREAMS = (
+    StreamSpec("colour", required=False),
+    StreamSpec("depth", required=False, multiple=True),
+    StreamSpec("thermal", required=False),
+    StreamSpec("left", required=False),
+    StreamSpec("right", required=False),
+)
 
 
 @dataclass(frozen=True)
@@ -64,30 +79,48 @@ class TopicSummary:
 
 @dataclass(frozen=True)
 class SelectedTopics:
-    """The topics the reader uses."""
+    """The topics the reader uses: an image topic and its CameraInfo per role."""
 
-    rgb: str
-    depth: str
-    rgb_info: str | None
-    depth_info: str | None
+    streams: Mapping[str, str]
+    infos: Mapping[str, str]
     odometry: str | None
     tf: tuple[str, ...]
     ground_truth: str | None
 
+    @property
+    def rgb(self) -> str | None:
+        return self.streams.get("colour")
+
+    @property
+    def depth(self) -> str | None:
+        return self.streams.get("depth")
+
+
+@dataclass(frozen=True)
+class StreamSync:
+    """How one stream paired with the reference stream."""
+
+    role: str
+    topic: str
+    messages: int
+    dropped: int
+    worst_gap_ms: float
+    mean_gap_ms: float
+
 
 @dataclass(frozen=True)
 class SyncStats:
-    """How well RGB and depth pair up."""
+    """How the streams pair up: per stream, against the reference (the first stream)."""
 
-    rgb_messages: int
-    depth_messages: int
-    paired: int
-    rgb_dropped: int
-    depth_dropped: int
+    reference: str
+    streams: tuple[StreamSync, ...]
+    frames: int
     no_pose_dropped: int
-    worst_gap_ms: float
-    mean_gap_ms: float
     max_gap_ms: float
+
+    @property
+    def worst_gap_ms(self) -> float:
+        return max((s.worst_gap_ms for s in self.streams), default=0.0)
 
 
 @dataclass(frozen=True)
@@ -100,14 +133,21 @@ class RecordingInfo:
     topics: tuple[TopicSummary, ...]
     selected: SelectedTopics
     sync: SyncStats
-    rgb_camera: CameraModel
-    depth_camera: CameraModel
+    cameras: Mapping[str, CameraModel]
     world_frame: str
     camera_frame: str
     tf_chain: tuple[str, ...]
     has_odometry: bool
     num_frames: int
     warnings: tuple[str, ...] = field(default_factory=tuple)
+
+    @property
+    def rgb_camera(self) -> CameraModel | None:
+        return self.cameras.get("colour")
+
+    @property
+    def depth_camera(self) -> CameraModel | None:
+        return self.cameras.get("depth")
 
 
 def container_kind(path: Path) -> str:
@@ -182,6 +222,16 @@ class _Index:
     gt_messages: int = 0
 
 
+@dataclass(frozen=True)
+class _FramePlan:
+    """One frame to decode: its stamp, each role's message index, each role's pose."""
+
+    stamp_ns: int
+    messages: Mapping[str, int]
+    stamps: Mapping[str, int]
+    poses: Mapping[str, Pose]
+
+
 class Recording:
     """An opened recording: its :class:`RecordingInfo` and its frame stream."""
 
@@ -190,75 +240,90 @@ class Recording:
         path: Path,
         io: IoConfig,
         info: RecordingInfo,
-        pairs: list[tuple[int, int, int]],
-        poses: list[Pose],
+        plan: list[_FramePlan],
         depth_to_rgb: Pose,
         ground_truth: groundtruth.GroundTruth | None,
     ) -> None:
         self.path = path
         self.io = io
         self.info = info
-        self._pairs = pairs  # (frame stamp, rgb message index, depth message index)
-        self._poses = poses
+        self._plan = plan
         self._depth_to_rgb = depth_to_rgb
         self.ground_truth_topic = ground_truth
 
     def __len__(self) -> int:
-        return len(self._pairs)
+        return len(self._plan)
 
     @property
     def frame_stamps(self) -> list[int]:
-        return [p[0] for p in self._pairs]
+        return [p.stamp_ns for p in self._plan]
 
     def frames(self) -> Iterator[Frame]:
         """Decode and yield the synchronised frames in stamp order."""
-        sel = self.info.selected
-        rgb_want = {r: k for k, (_, r, _) in enumerate(self._pairs)}
-        depth_want = {d: k for k, (_, _, d) in enumerate(self._pairs)}
-        rgb_ready: dict[int, NDArray[np.uint8]] = {}
-        depth_ready: dict[int, NDArray[np.float32]] = {}
-        counters = {sel.rgb: 0, sel.depth: 0}
+        sel = self.info.selected.streams
+        by_topic = {topic: role for role, topic in sel.items()}
+        wanted = {role: {p.messages[role]: k for k, p in enumerate(self._plan)} for role in sel}
+        ready: dict[int, dict[str, Any]] = {}
+        counters = dict.fromkeys(sel.values(), 0)
+        primary = "depth" if "depth" in sel else next(iter(sel))
         next_k = 0
         info = self.info
         try:
             with open_source(self.path) as src:
-                msgtypes = {t: src.topics[t].msgtype for t in (sel.rgb, sel.depth)}
-                for topic, _, raw in src.messages({sel.rgb, sel.depth}):
+                msgtypes = {t: src.topics[t].msgtype for t in sel.values()}
+                for topic, _, raw in src.messages(set(sel.values())):
                     n = counters[topic]
                     counters[topic] = n + 1
-                    is_rgb = topic == sel.rgb
-                    k = (rgb_want if is_rgb else depth_want).get(n)
+                    role = by_topic[topic]
+                    k = wanted[role].get(n)
                     if k is None:
                         continue
                     msg = src.deserialize(raw, msgtypes[topic])
-                    if is_rgb:
-                        rgb_ready[k] = self._decode(msg, topic, info.rgb_camera, color=True)
-                    else:
-                        depth_ready[k] = self._decode(msg, topic, info.depth_camera, color=False)
-                    while next_k in rgb_ready and next_k in depth_ready:
+                    ready.setdefault(k, {})[role] = self._decode(
+                        msg, topic, role, info.cameras[role]
+                    )
+                    while len(ready.get(next_k, ())) == len(sel):
+                        plan = self._plan[next_k]
+                        images = ready.pop(next_k)
+                        streams = {
+                            r: Stream(
+                                images[r][0],
+                                images[r][1],
+                                info.cameras[r],
+                                plan.stamps[r],
+                                plan.poses[r],
+                            )
+                            for r in sel
+                        }
                         yield Frame(
                             index=next_k,
-                            stamp_ns=self._pairs[next_k][0],
-                            rgb=rgb_ready.pop(next_k),
-                            depth=depth_ready.pop(next_k),
-                            rgb_camera=info.rgb_camera,
-                            depth_camera=info.depth_camera,
+                            stamp_ns=plan.stamp_ns,
+                            streams=streams,
                             depth_to_rgb=self._depth_to_rgb,
-                            camera_pose=self._poses[next_k],
+                            camera_pose=plan.poses[primary],
                             world_frame=info.world_frame,
                             has_odometry=info.has_odometry,
                         )
                         next_k += 1
         except READ_ERRORS as err:
             raise InputError(self.path, f"read failed after {next_k} frames: {err}") from err
-        if next_k != len(self._pairs):
+        if next_k != len(self._plan):
             raise InputError(
-                self.path, f"recording ended after {next_k} of {len(self._pairs)} indexed frames"
+                self.path, f"recording ended after {next_k} of {len(self._plan)} indexed frames"
             )
 
-    def _decode(self, msg: Any, topic: str, camera: CameraModel, color: bool) -> Any:
+    def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
+        kind = role_kind(role)
         try:
-            img = images.decode_color(msg) if color else images.decode_depth(msg)
+            if kind == "depth":
+                img: Any = images.decode_depth(msg)
+                encoding = "depth"
+            elif kind == "thermal":
+                img = images.decode_mono(msg)
+                encoding = "mono16" if img.dtype == np.uint16 else "mono8"
+            else:
+                img = images.decode_color(msg)
+                encoding = "rgb8"
         except images.ImageFormatError as err:
             raise DecodeError(self.path, str(err), topic) from err
         if img.shape[:2] != (camera.height, camera.width):
@@ -268,39 +333,143 @@ class Recording:
                 f"{camera.width}x{camera.height}",
                 topic,
             )
-        return img
+        return img, encoding
 
 
 # ----------------------------------------------------------------------------- opening
 
 
+def topic_flag(role: str) -> str:
+    """The command-line option that chooses the topic of ``role``."""
+    return f"--topic {role}=/name"
+
+
 def _choose(
-    path: Path, role: str, override: str | None, candidates: list[str], flag: str, required: bool
+    path: Path, role: str, what: str, override: str | None, candidates: list[str], required: bool
 ) -> str | None:
     if override is not None:
         if override not in candidates:
             raise TopicError(
                 path,
-                f"{flag} {override!r} is not a {role} topic here (candidates: "
-                f"{', '.join(candidates) or 'none'})",
+                f"{topic_flag(role).replace('/name', override)}: not a {what} topic here "
+                f"(candidates: {', '.join(candidates) or 'none'})",
                 override,
             )
         return override
     if not candidates:
         if required:
-            raise TopicError(path, f"no {role} topic found")
+            raise TopicError(path, f"no {what} topic found (choose one with {topic_flag(role)})")
         return None
     if len(candidates) > 1:
         raise TopicError(
-            path, f"several {role} topics: {', '.join(sorted(candidates))}; choose one with {flag}"
+            path,
+            f"several {what} topics: {', '.join(sorted(candidates))}; choose one with "
+            f"{topic_flag(role)}",
         )
     return candidates[0]
 
 
-def _is_depth_message(msg: Any) -> bool:
+_THERMAL_WORDS = ("thermal", "lwir", "flir", "temperature", "ir/")
+_DEPTH_WORDS = ("depth",)
+
+
+def image_kinds(topic: str, msg: Any) -> tuple[str, ...]:
+    """The roles an image topic can play, judged by its first message and its name.
+
+    16UC1/32FC1 and ``compressedDepth`` are depth; ``mono16`` is depth only when the
+    topic says so, thermal when it says so, and either otherwise (ambiguous: the user
+    chooses with ``--topic``); colour images on ``left``/``right`` topics are a stereo
+    pair; ``mono8`` is thermal on a thermal topic, else colour.
+    """
+    name = topic.lower()
     if hasattr(msg, "format"):
-        return "compressedDepth" in str(msg.format)
-    return str(msg.encoding) in images.DEPTH_ENCODINGS
+        if "compressedDepth" in str(msg.format):
+            return ("depth",)
+        encoding = "compressed"
+    else:
+        encoding = str(msg.encoding)
+    thermal = any(w in name for w in _THERMAL_WORDS)
+    if encoding in ("16UC1", "32FC1"):
+        return ("depth",)
+    if encoding == "mono16":
+        if thermal:
+            return ("thermal",)
+        return ("depth",) if any(w in name for w in _DEPTH_WORDS) else ("depth", "thermal")
+    if thermal:
+        return ("thermal",)
+    parts = name.replace("-", "/").replace("_", "/").split("/")
+    for side in ("left", "right"):
+        if side in parts:
+            return (side,)
+    return ("colour",)
+
+
+_KIND_NAMES = {
+    "colour": "colour image",
+    "depth": "depth image",
+    "thermal": "thermal image",
+    "left": "left stereo image",
+    "right": "right stereo image",
+}
+
+
+def _choose_streams(
+    path: Path, io: IoConfig, wanted: Sequence[StreamSpec], first: Mapping[str, Any]
+) -> dict[str, str]:
+    """Role -> topic for the wanted streams, by ``io.topics`` or by unambiguous message type."""
+    kinds = {t: image_kinds(t, m) for t, m in first.items()}
+    chosen: dict[str, str] = {}
+    for spec in wanted:
+        cands = sorted(t for t, k in kinds.items() if spec.role in k)
+        what = _KIND_NAMES[spec.role]
+        if spec.multiple:
+            extra = sorted(r for r in io.topics if role_kind(r) == spec.role and r != spec.role)
+            named = [io.topics[r] for r in (spec.role, *extra) if r in io.topics]
+            for topic in named:
+                if topic not in first:
+                    raise TopicError(path, f"--topic ...={topic}: not an image topic here", topic)
+            if named:
+                roles = [spec.role, *extra] if spec.role in io.topics else extra
+                chosen.update(zip(roles, named, strict=True))
+                continue
+            unambiguous = [t for t in cands if kinds[t] == (spec.role,)]
+            if not unambiguous and cands and spec.required:
+                raise TopicError(
+                    path,
+                    f"{', '.join(cands)} could be {what} or another kind; choose with "
+                    f"{topic_flag(spec.role)}",
+                )
+            if not unambiguous:
+                if spec.required:
+                    raise TopicError(path, f"no {what} topic found")
+                continue
+            for i, topic in enumerate(unambiguous):
+                chosen[spec.role if i == 0 else f"{spec.role}_{i + 1}"] = topic
+            continue
+        override = io.topic(spec.role)
+        if override is None and len(cands) > 1:
+            sure = [t for t in cands if kinds[t] == (spec.role,)]
+            cands = sure if len(sure) == 1 else cands
+        if override is None and len(cands) == 1 and len(kinds[cands[0]]) > 1:
+            if not spec.required:
+                continue  # an optional stream is never guessed
+            raise TopicError(
+                path,
+                f"{cands[0]} could be {what} or another kind; choose with {topic_flag(spec.role)}",
+            )
+        picked = _choose(path, spec.role, what, override, cands, spec.required)
+        if picked is not None:
+            chosen[spec.role] = picked
+    used: dict[str, str] = {}
+    for role, topic in chosen.items():
+        if topic in used:
+            raise TopicError(
+                path,
+                f"{topic} was chosen for both {used[topic]} and {role}; choose with "
+                f"{topic_flag(role)}",
+            )
+        used[topic] = role
+    return chosen
 
 
 def _info_for(image_topic: str, infos: list[str], override: str | None) -> str | None:
@@ -311,8 +480,17 @@ def _info_for(image_topic: str, infos: list[str], override: str | None) -> str |
     return same[0] if len(same) == 1 else None
 
 
-def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
-    """Index a recording (see the module docstring); raises :class:`InputError` subclasses."""
+def open_recording(
+    path: Path | str,
+    io: IoConfig | None = None,
+    streams: Sequence[StreamSpec] = RGBD_STREAMS,
+) -> Recording:
+    """Index a recording for ``streams`` (see the module docstring).
+
+    The first stream present is the reference: frames carry its stamps, and every
+    other stream is paired to it by nearest header stamp within ``io.max_sync_gap_ms``.
+    Raises :class:`InputError` subclasses.
+    """
     path = Path(path)
     io = io or IoConfig()
     if not path.exists():
@@ -333,24 +511,35 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
                 for _, _, raw in src.messages({conn.topic}):
                     first[conn.topic] = src.deserialize(raw, conn.msgtype)
                     break
-            depth_cands = [t for t, m in first.items() if _is_depth_message(m)]
-            rgb_cands = [t for t, m in first.items() if not _is_depth_message(m)]
-            rgb_topic = _choose(path, "RGB image", io.rgb_topic, rgb_cands, "--rgb-topic", True)
-            depth_topic = _choose(
-                path, "depth image", io.depth_topic, depth_cands, "--depth-topic", True
-            )
-            assert rgb_topic is not None and depth_topic is not None  # required=True
+            chosen = _choose_streams(path, io, streams, first)
+            if not chosen:
+                raise TopicError(
+                    path,
+                    "no image topic of the roles needed "
+                    f"({', '.join(s.role for s in streams)}) found",
+                )
             infos = [c.topic for c in conns if c.msgtype == CAMERA_INFO_TYPE]
-            rgb_info = _info_for(rgb_topic, infos, io.rgb_info_topic)
-            depth_info = _info_for(depth_topic, infos, io.depth_info_topic)
+            info_topics = {}
+            for role, topic in chosen.items():
+                named = io.topic(f"{role}_info")
+                if named is not None and named not in infos:
+                    raise TopicError(
+                        path,
+                        f"--topic {role}_info={named}: not a CameraInfo topic here "
+                        f"(candidates: {', '.join(sorted(infos)) or 'none'})",
+                        named,
+                    )
+                info_topic = _info_for(topic, infos, named)
+                if info_topic is not None:
+                    info_topics[role] = info_topic
             odoms = [c.topic for c in conns if c.msgtype == ODOMETRY_TYPE]
-            odom_topic = _choose(path, "odometry", io.odom_topic, odoms, "--odom-topic", False)
+            odom_topic = _choose(path, "odometry", "odometry", io.topic("odometry"), odoms, False)
             tf_topics = tuple(c.topic for c in conns if c.msgtype == TF_TYPE)
             gts = [c.topic for c in conns if c.msgtype == GT_ARRAY_TYPE]
-            gt_topic = _choose(path, "ground-truth", io.gt_topic, gts, "--gt-topic", False)
-            selected = SelectedTopics(
-                rgb_topic, depth_topic, rgb_info, depth_info, odom_topic, tf_topics, gt_topic
+            gt_topic = _choose(
+                path, "ground_truth", "ground-truth", io.topic("ground_truth"), gts, False
             )
+            selected = SelectedTopics(chosen, info_topics, odom_topic, tf_topics, gt_topic)
             index = _index_pass(path, src, selected)
     except READ_ERRORS as err:
         raise InputError(path, f"cannot read recording: {err}") from err
@@ -367,13 +556,10 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
         TopicSummary(c.topic, c.msgtype, c.count, rate(c.topic, c.count))
         for c in sorted(by_topic.values(), key=lambda c: c.topic)
     )
-    rgb_camera = _camera(path, selected.rgb_info, index, first[rgb_topic], rgb_topic, warnings)
-    depth_camera = _camera(
-        path, selected.depth_info, index, first[depth_topic], depth_topic, warnings
-    )
+    cameras = _cameras(path, selected, index, first, warnings)
 
     stamps = {}
-    for topic in (rgb_topic, depth_topic):
+    for role, topic in chosen.items():
         arr = np.asarray(index.stamps.get(topic, []), dtype=np.int64)
         bad = first_non_increasing(arr)
         if bad is not None:
@@ -383,26 +569,58 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
                 f"({int(arr[bad - 1])} then {int(arr[bad])} ns)",
                 topic,
             )
-        stamps[topic] = arr
+        stamps[role] = arr
+    reference = next(iter(chosen))
     max_gap_ns = int(io.max_sync_gap_ms * 1e6)
-    pairing: Pairing = pair_nearest(stamps[rgb_topic], stamps[depth_topic], max_gap_ns)
-    if not pairing.pairs:
-        raise SyncError(
-            path,
-            f"no RGB/depth pair within {io.max_sync_gap_ms} ms "
-            f"({rgb_topic}: {stamps[rgb_topic].size} messages, {depth_topic}: {stamps[depth_topic].size})",
+    partner: dict[str, dict[int, int]] = {}
+    stream_sync = []
+    for role in list(chosen)[1:]:
+        pairing: Pairing = pair_nearest(stamps[reference], stamps[role], max_gap_ns)
+        if not pairing.pairs:
+            smallest = _smallest_gap_ms(stamps[reference], stamps[role])
+            raise SyncError(
+                path,
+                f"no {reference}/{role} pair within {io.max_sync_gap_ms} ms "
+                f"({chosen[reference]}: {stamps[reference].size} messages, {chosen[role]}: "
+                f"{stamps[role].size}); the smallest offset is {smallest:.1f} ms: accept it "
+                f"with --set io.max_sync_gap_ms={math.ceil(smallest + 1)}",
+            )
+        partner[role] = dict(pairing.pairs)
+        stream_sync.append(
+            StreamSync(
+                role,
+                chosen[role],
+                int(stamps[role].size),
+                pairing.depth_unpaired,
+                pairing.worst_gap_ns / 1e6,
+                pairing.mean_gap_ns / 1e6,
+            )
         )
 
-    camera_frame = depth_camera.frame_id or depth_topic
+    primary = "depth" if "depth" in chosen else reference
+    camera_frame = cameras[primary].frame_id or chosen[primary]
     world_frame, has_odometry, chain = _world(path, io, index, camera_frame, odom_topic, warnings)
-    depth_to_rgb = _depth_to_rgb(index.tf, rgb_camera, depth_camera, warnings)
+    colour, depth = cameras.get("colour"), cameras.get("depth")
+    depth_to_rgb = (
+        _depth_to_rgb(index.tf, colour, depth, warnings)
+        if colour is not None and depth is not None
+        else Pose.identity()
+    )
+    # Each other camera's pose relative to the primary one (static extrinsics from tf).
+    extrinsics: dict[str, Pose] = {}
+    for role, cam in cameras.items():
+        if role != primary:
+            extrinsics[role] = _extrinsics(index.tf, cameras[primary], cam, role, warnings)
 
     tol = int(io.max_pose_extrapolation_ms * 1e6)
-    pairs: list[tuple[int, int, int]] = []
-    poses: list[Pose] = []
+    plan: list[_FramePlan] = []
     no_pose = 0
-    for r, d in pairing.pairs:
-        stamp = int(stamps[rgb_topic][r])
+    ref_stamps = stamps[reference]
+    for r in range(ref_stamps.size):
+        if not all(r in partner[role] for role in partner):
+            continue
+        stamp = int(ref_stamps[r])
+        messages = {reference: r, **{role: partner[role][r] for role in partner}}
         if has_odometry:
             try:
                 pose = index.tf.lookup(world_frame, camera_frame, stamp, tol)
@@ -411,9 +629,20 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
                 continue
         else:
             pose = OPTICAL_TO_BODY
-        pairs.append((stamp, r, d))
-        poses.append(pose)
-    if not pairs:
+        poses = {primary: pose}
+        for role, ext in extrinsics.items():
+            poses[role] = pose.compose(ext)
+        plan.append(
+            _FramePlan(
+                stamp,
+                messages,
+                {role: int(stamps[role][i]) for role, i in messages.items()},
+                poses,
+            )
+        )
+    if not plan:
+        if partner and not any(partner.values()):
+            raise SyncError(path, "no frame has every stream within the sync gap")
         raise TransformError(path, f"no frame has a pose from {world_frame!r} to {camera_frame!r}")
     if no_pose:
         warnings.append(
@@ -429,21 +658,24 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
         except GroundTruthError as err:
             raise InputError(path, str(err), gt_topic) from err
 
+    ref_sync = StreamSync(
+        reference,
+        chosen[reference],
+        int(ref_stamps.size),
+        int(ref_stamps.size) - len(plan) - no_pose,
+        0.0,
+        0.0,
+    )
     sync = SyncStats(
-        rgb_messages=int(stamps[rgb_topic].size),
-        depth_messages=int(stamps[depth_topic].size),
-        paired=len(pairing.pairs),
-        rgb_dropped=pairing.rgb_unpaired,
-        depth_dropped=pairing.depth_unpaired,
+        reference=reference,
+        streams=(ref_sync, *stream_sync),
+        frames=len(plan),
         no_pose_dropped=no_pose,
-        worst_gap_ms=pairing.worst_gap_ns / 1e6,
-        mean_gap_ms=pairing.mean_gap_ns / 1e6,
         max_gap_ms=io.max_sync_gap_ms,
     )
-    if pairing.rgb_unpaired or pairing.depth_unpaired:
-        warnings.append(
-            f"unpaired messages dropped: {pairing.rgb_unpaired} RGB, {pairing.depth_unpaired} depth"
-        )
+    dropped = [f"{s.dropped} {s.role}" for s in sync.streams if s.dropped]
+    if dropped:
+        warnings.append(f"unpaired messages dropped: {', '.join(dropped)}")
     info = RecordingInfo(
         path=str(path),
         container=kind,
@@ -451,16 +683,26 @@ def open_recording(path: Path | str, io: IoConfig | None = None) -> Recording:
         topics=topics,
         selected=selected,
         sync=sync,
-        rgb_camera=rgb_camera,
-        depth_camera=depth_camera,
+        cameras=cameras,
         world_frame=world_frame,
         camera_frame=camera_frame,
         tf_chain=tuple(chain),
         has_odometry=has_odometry,
-        num_frames=len(pairs),
+        num_frames=len(plan),
         warnings=tuple(warnings),
     )
-    return Recording(path, io, info, pairs, poses, depth_to_rgb, gt)
+    return Recording(path, io, info, plan, depth_to_rgb, gt)
+
+
+def _smallest_gap_ms(a: NDArray[np.int64], b: NDArray[np.int64]) -> float:
+    """The smallest |a_i - b_j| in milliseconds (both sorted, non-empty)."""
+    if a.size == 0 or b.size == 0:
+        return float("inf")
+    j = np.clip(np.searchsorted(b, a), 1, b.size - 1) if b.size > 1 else np.zeros(a.size, int)
+    gaps = np.abs(a - b[j])
+    if b.size > 1:
+        gaps = np.minimum(gaps, np.abs(a - b[j - 1]))
+    return float(gaps.min()) / 1e6
 
 
 def _rate(stamps: list[int] | None) -> float | None:
@@ -472,17 +714,19 @@ def _rate(stamps: list[int] | None) -> float | None:
 
 def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
     index = _Index()
-    small = {t for t in (sel.rgb_info, sel.depth_info, sel.odometry, sel.ground_truth) if t}
+    images_ = set(sel.streams.values())
+    infos = set(sel.infos.values())
+    small = {t for t in (sel.odometry, sel.ground_truth) if t} | infos
     small.update(sel.tf)
-    wanted = small | {sel.rgb, sel.depth}
+    wanted = small | images_
     for topic, log_ns, raw in src.messages(wanted):
         msgtype = src.topics[topic].msgtype
-        if topic in (sel.rgb, sel.depth):
+        if topic in images_:
             index.stamps.setdefault(topic, []).append(_header_stamp(raw, src.ros1))
             continue
         index.log_stamps.setdefault(topic, []).append(log_ns)
         msg: Any = src.deserialize(raw, msgtype)
-        if topic in (sel.rgb_info, sel.depth_info):
+        if topic in infos:
             index.first_msgs.setdefault(topic, msg)
         elif topic == sel.odometry:
             parent, child = msg.header.frame_id.lstrip("/"), msg.child_frame_id.lstrip("/")
@@ -535,16 +779,54 @@ def _add_tf(
         raise TransformError(path, str(err), topic) from err
 
 
-def _camera(
-    path: Path, info_topic: str | None, index: _Index, first: Any, topic: str, warnings: list[str]
-) -> CameraModel:
-    msg = index.first_msgs.get(info_topic) if info_topic else None
-    if msg is None:
-        raise TopicError(
-            path,
-            "no CameraInfo for this image topic (set it with --rgb-info-topic/--depth-info-topic)",
-            topic,
-        )
+def _cameras(
+    path: Path,
+    sel: SelectedTopics,
+    index: _Index,
+    first: Mapping[str, Any],
+    warnings: list[str],
+) -> dict[str, CameraModel]:
+    """Each stream's camera model from its CameraInfo.
+
+    A depth image without CameraInfo of its own that has the colour image's frame id
+    and size is registered to it (``depth_registered`` topics): it takes the colour
+    camera's model, with a warning.
+    """
+    cameras: dict[str, CameraModel] = {}
+    order = sorted(sel.streams, key=lambda r: r in sel.infos, reverse=True)  # own info first
+    for role in order:
+        topic = sel.streams[role]
+        info_topic = sel.infos.get(role)
+        msg = index.first_msgs.get(info_topic) if info_topic else None
+        if msg is None:
+            colour = cameras.get("colour")
+            img = first[topic]
+            frame_id = img.header.frame_id.lstrip("/")
+            if (
+                role_kind(role) == "depth"
+                and colour is not None
+                and frame_id == colour.frame_id
+                and (
+                    hasattr(img, "format")
+                    or (int(img.width), int(img.height)) == (colour.width, colour.height)
+                )
+            ):
+                warnings.append(
+                    f"{topic} has no CameraInfo of its own: registered to the colour image "
+                    f"({sel.infos.get('colour')}), whose camera model it takes"
+                )
+                cameras[role] = colour
+                continue
+            raise TopicError(
+                path,
+                f"no CameraInfo for this image topic (choose it with --topic {role}_info=/name)",
+                topic,
+            )
+        cameras[role] = _camera(path, info_topic, msg, first[topic], topic)
+    return {role: cameras[role] for role in sel.streams}
+
+
+def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str) -> CameraModel:
     try:
         camera = camera_model_from_info(msg)
     except ValueError as err:
@@ -588,6 +870,12 @@ def _world(
         world = index.odom_frames[0]
     else:
         world = next((f for f in ("map", "odom", "world") if f in tf.frames), "")
+    static_world = bool(world) and not tf.has_dynamic and world in tf.frames
+    if static_world:  # a static rig: cameras placed in the world by /tf_static alone
+        try:
+            return world, True, tf.chain(world, camera_frame)
+        except TransformLookupError:
+            static_world = False
     if not world or not tf.has_dynamic:
         if io.world_frame is not None:
             raise TransformError(
@@ -599,6 +887,22 @@ def _world(
     except TransformLookupError as err:
         raise TransformError(path, f"broken tf chain: {err}") from err
     return world, True, chain
+
+
+def _extrinsics(
+    tf: TfBuffer, primary: CameraModel, camera: CameraModel, role: str, warnings: list[str]
+) -> Pose:
+    """``primary_optical_T_camera_optical`` from static tf (identity when one frame)."""
+    if camera.frame_id == primary.frame_id:
+        return Pose.identity()
+    try:
+        return tf.lookup(primary.frame_id, camera.frame_id, 0, tolerance_ns=2**62)
+    except TransformLookupError:
+        warnings.append(
+            f"no tf between {primary.frame_id!r} and {camera.frame_id!r} ({role}): "
+            "the two cameras are assumed to share one optical frame"
+        )
+        return Pose.identity()
 
 
 def _depth_to_rgb(tf: TfBuffer, rgb: CameraModel, depth: CameraModel, warnings: list[str]) -> Pose:

@@ -343,6 +343,49 @@ class RecordingWriter:
             self.camera_info(stamp_ns, camera, DEPTH_INFO_TOPIC),
         )
 
+    def write_image(
+        self,
+        topic: str,
+        info_topic: str,
+        stamp_ns: int,
+        image: NDArray[Any],
+        camera: CameraModel,
+        encoding: str,
+    ) -> None:
+        """A raw ``sensor_msgs/Image`` on any topic, and its CameraInfo on ``info_topic``.
+
+        ``encoding``: ``rgb8`` (``HxWx3 uint8``), ``mono8`` (uint8), ``mono16`` (uint16 raw
+        counts, e.g. a thermal camera), ``16UC1``/``32FC1`` (depth in metres, NaN invalid).
+        One sensor per topic pair: a rig of several cameras calls this once per camera.
+        """
+        if image.shape[:2] != (camera.height, camera.width):
+            raise ValueError(
+                f"image shape {image.shape} does not match camera {camera.width}x{camera.height}"
+            )
+        if encoding in ("16UC1", "32FC1"):
+            fields = images.encode_depth_raw(image, encoding)
+        elif encoding == "rgb8":
+            fields = images.encode_color_raw(image)
+        elif encoding in ("mono8", "mono16"):
+            arr = np.ascontiguousarray(image, dtype=np.uint8 if encoding == "mono8" else "<u2")
+            fields = {
+                "height": camera.height,
+                "width": camera.width,
+                "encoding": encoding,
+                "is_bigendian": 0,
+                "step": camera.width * arr.itemsize,
+                "data": np.frombuffer(arr.tobytes(), dtype=np.uint8),
+            }
+        else:
+            raise ValueError(f"encoding={encoding!r}: expected rgb8, mono8, mono16, 16UC1 or 32FC1")
+        header = self.header(stamp_ns, camera.frame_id, topic)
+        self.write_message(
+            topic, IMAGE_TYPE, stamp_ns, self._t(IMAGE_TYPE)(header=header, **fields)
+        )
+        self.write_message(
+            info_topic, CAMERA_INFO_TYPE, stamp_ns, self.camera_info(stamp_ns, camera, info_topic)
+        )
+
     def write_ground_truth(
         self, stamp_ns: int, world_frame: str, objects: list[GroundTruthObject]
     ) -> None:

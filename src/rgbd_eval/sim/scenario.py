@@ -12,14 +12,23 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    SerializeAsAny,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
-from rgbd_eval.config import format_validation_error, load_yaml, repo_root, set_dotted
+from rgbd_eval.config import config_dir, format_validation_error, load_yaml, set_dotted
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.sim.rig_sensors import RigSensorConfig, rig_sensor_config
 
 Colour = tuple[int, int, int]
 
@@ -347,9 +356,24 @@ class Scenario(_Model):
     sensor: Sensor = Sensor()
     odometry: Odometry = Odometry()
     recording: Recording = Recording()
+    rig: list[SerializeAsAny[RigSensorConfig]] = Field(
+        default_factory=list,
+        description="extra sensors beside the robot's Kinect, each selected by its 'kind' "
+        "(rgbd_eval.sim.rig_sensors), on topics /<name>/...",
+    )
+
+    @field_validator("rig", mode="before")
+    @classmethod
+    def _rig(cls, value: Any) -> Any:
+        if not isinstance(value, list):
+            return value
+        return [rig_sensor_config(v) if isinstance(v, Mapping) else v for v in value]
 
     @model_validator(mode="after")
     def _check(self) -> Scenario:
+        names = [r.name for r in self.rig]
+        if len(set(names)) != len(names):
+            raise ValueError(f"rig sensor names must be unique, got {names}")
         ids = [p.id for p in self.people]
         if len(set(ids)) != len(ids):
             raise ValueError(f"person ids must be unique, got {ids}")
@@ -400,7 +424,7 @@ def load_scenario(path: Path | str, overrides: Iterable[tuple[str, Any]] = ()) -
 
 def scenarios_dir() -> Path:
     """``configs/scenarios`` of the source checkout."""
-    return repo_root() / "configs" / "scenarios"
+    return config_dir() / "scenarios"
 
 
 def scenario_paths() -> list[Path]:

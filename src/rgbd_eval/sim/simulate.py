@@ -41,6 +41,7 @@ from rgbd_eval.sim.render import (
     render_hits,
     shade,
 )
+from rgbd_eval.sim.rig_sensors import SceneView
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.sensor import (
     depth_edges,
@@ -59,6 +60,8 @@ _STREAM_ODOMETRY = 1
 _STREAM_DEPTH = 2
 _STREAM_RGB = 3
 _STREAM_RGB_BANK = 4
+#: First noise stream of the rig's extra sensors (one stream each, in rig order).
+_STREAM_RIG = 100
 #: Noise images drawn once per recording; each frame shifts one of them at random.
 _NOISE_BANK = 4
 
@@ -127,6 +130,8 @@ class Simulator:
         self.static = static_mesh(scenario.room, scenario.obstacles)
         self._static_scene = make_scene(self.static)
         self._static_hits: dict[str, tuple[tuple[object, ...], Hits]] = {}
+        #: The people of the last rendered frame (index, mesh, scene), reused by scene_view.
+        self._people: tuple[int, Mesh, o3d.t.geometry.RaycastingScene] | None = None
         self.light = light_direction(s.light_azimuth_deg, s.light_elevation_deg)
         leaders = {p.id: p for p in scenario.people if p.follow is None}
         timelines = {pid: person_timeline(p) for pid, p in leaders.items()}
@@ -202,6 +207,7 @@ class Simulator:
         people_mesh = concatenate([m for _, m, _, _ in people])
         mesh = concatenate([self.static, people_mesh])
         people_scene = make_scene(people_mesh)
+        self._people = (index, people_mesh, people_scene)
 
         # RGB: shaded colour and the id buffer used for visibility
         hits = self._render(people_mesh, people_scene, self.rgb_camera, rgb_pose)
@@ -262,6 +268,28 @@ class Simulator:
             self._static_hits[camera.frame_id] = base
         window = people_window(people, camera, pose)
         return overlay_hits(base[1], people_scene, window, self.static.n_triangles)
+
+    def scene_view(self, index: int, stream: int) -> SceneView:
+        """Frame ``index`` for a rig sensor: its stamp and a renderer of the same scene.
+
+        ``stream`` seeds the sensor's own noise (one stream per sensor), so every
+        sensor's output depends only on the seed, the frame and the sensor.
+        """
+        if self._people is None or self._people[0] != index:
+            people_mesh = concatenate([m for _, m, _, _ in self.people_meshes(self.time(index))])
+            self._people = (index, people_mesh, make_scene(people_mesh))
+        _, people_mesh, people_scene = self._people
+
+        def render(camera: CameraModel, pose: Pose) -> Hits:
+            return self._render(people_mesh, people_scene, camera, pose)
+
+        return SceneView(
+            index,
+            self.scenario.stamp_ns(index),
+            rig.WORLD_FRAME,
+            render,
+            _rng(self.seed, _STREAM_RIG + stream, index),
+        )
 
     def frames(self, indices: list[int] | None = None) -> Iterator[SimFrame]:
         """Frames in order (all, or the given indices)."""

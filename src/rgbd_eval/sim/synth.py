@@ -15,10 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
-from rgbd_eval.config import repo_root
+from rgbd_eval.config import data_home
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
 from rgbd_eval.sim import rig
+from rgbd_eval.sim.rig_sensors import make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
 from rgbd_eval.sim.simulate import SimFrame, Simulator
 from rgbd_eval.types import GroundTruthObject
@@ -112,8 +113,14 @@ def synthesize(
         w.write_static_transform(first, rig.BASE_FRAME, rig.CAMERA_LINK, sim.base_to_link)
         w.write_static_transform(first, rig.CAMERA_LINK, rig.RGB_FRAME, sim.link_to_rgb)
         w.write_static_transform(first, rig.CAMERA_LINK, rig.DEPTH_FRAME, sim.link_to_depth)
+        extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
+        for sensor in extra:
+            for parent, child, pose in sensor.static_transforms():
+                w.write_static_transform(first, parent, child, pose)
         for f in sim.frames(list(range(total))):
             _write_frame(w, sim, f)
+            for k, sensor in enumerate(extra):
+                sensor.write(w, sim.scene_view(f.index, k))
             truth.extend(f.ground_truth)
             if progress is not None:
                 progress(f.index + 1, total)
@@ -132,13 +139,14 @@ DEMO = "demo"
 def dataset_path(name: str, container: SynthContainer = "mcap") -> Path:
     """Where ``synth --all`` puts a scenario's recording.
 
-    The small demo lives in ``datasets/`` (committed or generated on first use);
-    the thesis sequences go to the git-ignored ``datasets/generated/``.
+    The small demo lives in the data folder (:func:`rgbd_eval.config.data_home`:
+    ``datasets/`` in a checkout, a user cache folder otherwise), generated on first
+    use; the other scenarios go to its ``generated/`` subfolder.
     """
     if container not in ("ros1", "mcap"):
         raise ValueError(f"container={container!r} must be 'ros1' or 'mcap'")
     suffix = ".bag" if container == "ros1" else ".mcap"
-    folder = repo_root() / "datasets"
+    folder = data_home()
     if name != DEMO:
         folder = folder / "generated"
     return folder / f"{name}{suffix}"
@@ -149,6 +157,24 @@ def demo_recording(progress: ProgressCallback | None = None) -> Path:
     path = dataset_path(DEMO)
     if not path.exists() or not ground_truth_path(path).exists():
         synthesize(load_scenario(scenarios_dir() / f"{DEMO}.yaml"), path, "mcap", None, progress)
+    return path
+
+
+def ensure_scenario(
+    name_or_path: str, folder: Path | None = None, say: Callable[[str], None] | None = None
+) -> Path:
+    """The recording of a scenario (a name in ``configs/scenarios`` or a YAML path),
+    generated into ``folder`` (default: :func:`dataset_path`) when absent."""
+    source = Path(name_or_path)
+    yaml_path = (
+        source if source.suffix in (".yaml", ".yml") else scenarios_dir() / f"{name_or_path}.yaml"
+    )
+    name = yaml_path.stem
+    path = dataset_path(name) if folder is None else Path(folder) / f"{name}.mcap"
+    if not path.exists() or not ground_truth_path(path).exists():
+        if say is not None:
+            say(f"generating {path} ...")
+        synthesize(load_scenario(yaml_path), path, "mcap")
     return path
 
 

@@ -1,6 +1,5 @@
-"""Trackers: the protocol and name registry, filters, association, and one module per method."""
+"""Trackers: the protocol, filters, association, and one module per method (registered on import)."""
 
-from rgbd_eval.track import basso2012 as _basso2012  # noqa: F401  (registers "basso2012")
-from rgbd_eval.track.protocol import Tracker, create_tracker, known_trackers, register_tracker
+from rgbd_eval.track.protocol import Tracker, create_tracker, needs_frame
 
-__all__ = ["Tracker", "create_tracker", "known_trackers", "register_tracker"]
+__all__ = ["Tracker", "create_tracker", "needs_frame"]

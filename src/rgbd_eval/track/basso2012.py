@@ -31,13 +31,13 @@ detection's height.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.config import ClusterSelection, RunConfig
+from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import ukf
 from rgbd_eval.track.association import (
     chi_square_gate,
@@ -45,6 +45,7 @@ from rgbd_eval.track.association import (
     mahalanobis_sq,
     score_assign,
 )
+from rgbd_eval.track.basso2012_config import Basso2012TrackerConfig, ClusterSelection
 from rgbd_eval.track.boosting import OnlineBoostingClassifier, integral_histograms
 from rgbd_eval.track.motion import (
     apply_measurement,
@@ -52,8 +53,7 @@ from rgbd_eval.track.motion import (
     measurement_variance,
     process_noise,
 )
-from rgbd_eval.track.protocol import register_tracker
-from rgbd_eval.types import Box2D, Detection, TrackOutput, TrackStatus, Visibility
+from rgbd_eval.types import Box2D, Detection, Frame, TrackOutput, TrackStatus, Visibility
 
 Array = NDArray[np.float64]
 
@@ -84,15 +84,24 @@ class _Track:
     by_classifier: bool = False  # this frame's detection came from the classifier step
 
 
-@register_tracker("basso2012")
 class Basso2012Tracker:
-    """Tracking by detection with an UKF and on-line boosted re-identification (seed 000, ch. 6)."""
+    """Tracking by detection with an UKF and on-line boosted re-identification (seed 000, ch. 6).
 
-    def __init__(self, config: RunConfig) -> None:
-        cfg = config.tracker
+    ``contract`` says what the detections carry: the position quantum (the voxel side)
+    enters the measurement noise (6.7), and the classifier learns the colour histograms
+    (6.2.2), whose bins per channel follow from their length.
+    """
+
+    #: No sub-stages: ``bench`` shows the whole update as ``track``.
+    last_timings: Mapping[str, float] = {}
+
+    def __init__(self, cfg: Basso2012TrackerConfig, contract: DetectionContract) -> None:
+        problem = check_contract(cfg, contract)
+        if problem is not None:
+            raise ValueError(problem)
         self._cfg = cfg
-        self._bins = config.detector.histogram_bins
-        self._voxel = config.detector.voxel_size
+        self._bins = _histogram_bins(contract.appearance_size) if cfg.classifier else 8
+        self._voxel = contract.position_resolution_m
         self._gate = chi_square_gate(cfg.gate_distance_probability, 2)
         self._old_ns = _ns(cfg.seconds(cfg.frames_before_old))
         self._fake_ns = _ns(cfg.seconds(cfg.frames_before_fake))
@@ -116,7 +125,9 @@ class Basso2012Tracker:
 
     # ------------------------------------------------------------------ public
 
-    def update(self, stamp_ns: int, detections: Sequence[Detection]) -> list[TrackOutput]:
+    def update(
+        self, stamp_ns: int, detections: Sequence[Detection], frame: Frame | None = None
+    ) -> list[TrackOutput]:
         """Consume one frame's detections; return every maintained track, ordered by id."""
         if self._last_ns is not None and stamp_ns <= self._last_ns:
             raise ValueError(f"stamp_ns={stamp_ns} must increase (previous frame: {self._last_ns})")
@@ -426,3 +437,34 @@ def _appearance(det: Detection) -> NDArray[np.float32]:
     if det.appearance is None:
         raise RuntimeError("detection without appearance used for classification")
     return det.appearance
+
+
+def _histogram_bins(size: int) -> int:
+    """Bins per channel of a 3D histogram of ``size`` cells (0 when not a cube)."""
+    bins = round(size ** (1.0 / 3.0))
+    return bins if bins >= 2 and bins**3 == size else 0
+
+
+def check_contract(cfg: Basso2012TrackerConfig, contract: DetectionContract) -> str | None:
+    """Why detections of ``contract`` cannot feed this tracker (None: they can)."""
+    if not contract.world_position:
+        return "it tracks ground-plane positions, which these detections do not carry"
+    if cfg.classifier and not (
+        contract.appearance == "rgb_histogram" and _histogram_bins(contract.appearance_size)
+    ):
+        return (
+            "its on-line classifier learns 3D colour histograms (6.2.2), and these detections "
+            f"carry {contract.appearance or 'no appearance'}; set tracker.classifier=false"
+        )
+    return None
+
+
+SPEC = register_tracker(
+    TrackerSpec(
+        name="basso2012",
+        config_model=Basso2012TrackerConfig,
+        factory=Basso2012Tracker,
+        check=check_contract,
+        summary="UKF, GNN + on-line boosting, track management (seed 000, ch. 6)",
+    )
+)

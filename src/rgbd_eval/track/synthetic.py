@@ -120,12 +120,12 @@ def time_tracker(
     name: str = "basso2012", frames: int = 750, classifier: bool = True
 ) -> tuple[float, float]:
     """Mean wall-clock and CPU seconds per ``update`` for :data:`THREE_PEOPLE` at 30 Hz."""
-    from rgbd_eval.config import RunConfig, TrackerConfig
+    from rgbd_eval.config import build_config
     from rgbd_eval.track.protocol import create_tracker
 
-    config = RunConfig(tracker=TrackerConfig(classifier=classifier))
+    config = build_config({"tracker": {"name": name, "classifier": classifier}})
     stream = walking_stream(THREE_PEOPLE, frames)
-    tracker = create_tracker(name, config)
+    tracker = create_tracker(config)
     wall, cpu = time.perf_counter(), time.process_time()
     for stamp, dets in stream:
         tracker.update(stamp, dets)
