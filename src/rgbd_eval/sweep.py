@@ -333,7 +333,7 @@ def run_sweep(
                 warnings.simplefilter("always", CacheWarning)
                 cached = cache.load(detection_key(digests[path], cfg))
             rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
-        prepared[group] = client.submit(
+        prep = client.submit(
             _prepare,
             path.resolve(),
             digests.get(path),
@@ -343,9 +343,13 @@ def run_sweep(
             client.scatter(cached) if cached is not None else None,
             pure=False,
         )
-        briefs[group] = client.submit(_brief, prepared[group], pure=False)
+        briefs[group] = client.submit(_brief, prep, pure=False)
         for i in members:
-            tracked[i] = client.submit(_track, prepared[group], units[i][1], pure=False)
+            tracked[i] = client.submit(_track, prep, units[i][1], pure=False)
+        if client_side:
+            # Kept to fetch fresh detections. Otherwise the client holds no reference, so
+            # the scheduler frees the detections once this group's track tasks are done.
+            prepared[group] = prep
     stage = {f.key: "detect" for f in briefs.values()}
     stage |= {f.key: "track+score" for f in tracked.values()}
     totals = {"detect": len(briefs), "track+score": len(tracked)}
