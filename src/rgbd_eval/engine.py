@@ -79,7 +79,8 @@ def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator
 
     A remote scheduler must answer, and have a worker, within ``timeout_s``.
     """
-    from distributed import Client, LocalCluster
+    import dask
+    from distributed import Client
 
     if spec.address is not None:
         try:
@@ -96,6 +97,15 @@ def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator
         with client:
             yield client
         return
+    # No dashboard here, so no use for the workers' statistical profiler, which samples the
+    # running task's stack every 10 ms (measured: 0.40 -> 0.36 CPU s per tracking task).
+    with dask.config.set({"distributed.worker.profile.enabled": False}):
+        yield from _local(spec)
+
+
+def _local(spec: ClusterSpec) -> Iterator[Client]:
+    from distributed import Client, LocalCluster
+
     try:
         cluster = LocalCluster(
             n_workers=spec.workers,
