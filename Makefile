@@ -22,6 +22,10 @@ $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
 	$(BIN)/python -m pip install -q -e ".[dev]"
+	@# Test-only parity reference of the `motchallenge` convention (TrackEval, PyPI packaging).
+	@# Without its dependencies: it requires opencv-python, which would shadow our headless
+	@# OpenCV; its metrics need only numpy and scipy.
+	$(BIN)/python -m pip install -q --no-deps "trackeval==1.3.0"
 	@touch $(STAMP)
 
 setup: $(STAMP)

@@ -24,6 +24,7 @@ DEFAULT_TOLERANCES: dict[str, tuple[Better, float]] = {
     "mota": (Better.HIGHER, 0.01),
     "motp": (Better.HIGHER, 0.01),  # direction flips to LOWER under metric gating (metres)
     "idf1": (Better.HIGHER, 0.01),
+    "hota": (Better.HIGHER, 0.01),
     "main_tr": (Better.HIGHER, 0.02),
     "all_tr": (Better.HIGHER, 0.01),
     "fp_rate": (Better.LOWER, 0.01),
@@ -32,6 +33,10 @@ DEFAULT_TOLERANCES: dict[str, tuple[Better, float]] = {
     "recall_errors": (Better.LOWER, 0.0),
     "fragmentations": (Better.LOWER, 0.0),
 }
+
+
+#: Reports written before conventions existed were scored the motmetrics way.
+_LEGACY_CONVENTION = "motmetrics"
 
 
 class Status(enum.Enum):
@@ -145,6 +150,14 @@ def compare_reports(
             raise CompareInputError(
                 f"different datasets: sequence {name!r} has different content (sha256)"
             )
+    conventions = [
+        r["evaluation"].get("convention", _LEGACY_CONVENTION) for r in (baseline, current)
+    ]
+    if conventions[0] != conventions[1]:
+        raise CompareInputError(
+            f"different conventions: baseline scored with {conventions[0]!r}, current with "
+            f"{conventions[1]!r}; rescore one of them with --convention"
+        )
     gating = baseline["evaluation"]["gating"]
     if (
         gating != current["evaluation"]["gating"]
@@ -189,7 +202,7 @@ def compare_reports(
 def _fmt(value: float | None, metric: str) -> str:
     if value is None:
         return "-"
-    if metric.endswith("_rate") or metric in ("mota", "idf1", "main_tr", "all_tr"):
+    if metric.endswith("_rate") or metric in ("mota", "idf1", "hota", "main_tr", "all_tr"):
         return f"{100 * value:.2f}%"
     if metric == "motp":
         return f"{value:.4f}"

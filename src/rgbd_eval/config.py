@@ -98,6 +98,19 @@ class Gating(enum.Enum):
     METRIC = "metric"
 
 
+class Convention(enum.Enum):
+    """Which reference the CLEAR MOT matching reproduces exactly (see ``rgbd_eval.metrics``).
+
+    ``motchallenge``: the official devkit as TrackEval reproduces it (a previous match is
+    kept only from the previous frame; MT means tracked in more than 80 % of frames).
+    ``motmetrics``: py-motmetrics 1.4 (a previous match is kept while it stays in the gate,
+    however long ago; MT at 80 % or more).
+    """
+
+    MOTCHALLENGE = "motchallenge"
+    MOTMETRICS = "motmetrics"
+
+
 class EvaluationConfig(_Model):
     """Scoring settings."""
 
@@ -110,6 +123,12 @@ class EvaluationConfig(_Model):
     )
     min_visibility: float = Field(
         0.0, ge=0.0, le=1.0, description="ground truth less visible than this is ignored"
+    )
+    # The benchmark's convention by default: published MOTChallenge numbers are computed
+    # with it, and motmetrics 1.4's long-memory matching is a bug fixed upstream in 2023.
+    convention: Convention = Field(
+        Convention.MOTCHALLENGE,
+        description="'motchallenge' (devkit/TrackEval) or 'motmetrics' (py-motmetrics 1.4)",
     )
 
     def effective_threshold(self) -> float:

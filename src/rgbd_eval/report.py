@@ -21,9 +21,9 @@ from pathlib import Path
 from typing import Any
 
 from rgbd_eval import __version__
-from rgbd_eval.config import Gating, RunConfig, config_to_dict
+from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.metrics import Counts, Summary, summarize, total
+from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
 from rgbd_eval.pipeline import SequenceResult
 
 REPORT_SCHEMA_VERSION = 1
@@ -35,7 +35,6 @@ _LIBRARIES = (
     "open3d",
     "rosbags",
     "mcap",
-    "motmetrics",
     "pydantic",
 )
 
@@ -49,11 +48,21 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("main_tr", "Main Tr.", "pct"),
     ("all_tr", "All Tr.", "pct"),
     ("idf1", "IDF1", "pct"),
+    ("hota", "HOTA", "pct"),
     ("mt", "MT", "int"),
     ("ml", "ML", "int"),
     ("fragmentations", "Frag.", "int"),
     ("recall_errors", "Rec. err.", "int"),
 )
+
+
+#: How each convention matches, for the report header.
+MATCHING = {
+    Convention.MOTCHALLENGE: "motchallenge (devkit/TrackEval): a previous match is kept only "
+    "from the previous frame; MT means tracked in more than 80% of frames",
+    Convention.MOTMETRICS: "motmetrics 1.4: a previous match is kept while it stays within "
+    "the gate, however long ago; MT means tracked in 80% of frames or more",
+}
 
 
 def file_digest(path: Path) -> str:
@@ -185,7 +194,8 @@ def report_dict(
             "motp": "mean IoU of matches (higher is better)"
             if gating is Gating.IOU
             else "mean ground-plane distance of matches in metres (lower is better)",
-            "matching": "motmetrics: a previous match is kept while it stays within the gate",
+            "convention": config.evaluation.convention.value,
+            "matching": MATCHING[config.evaluation.convention],
         },
         "config": config_to_dict(config),
         "sequences": [sequence_record(r, d) for r, d in zip(results, digests, strict=True)],
@@ -283,6 +293,35 @@ def tracks_csv(r: SequenceResult) -> str:
     return _csv(rows, header)
 
 
+EVENTS_HEADER = ("frame", "stamp_ns", "event", "gt_id", "track_id", "similarity", "recall_error")
+
+
+def events_csv(
+    frames: Sequence[FrameEvents],
+    stamps_ns: Sequence[int],
+    frame_numbers: Sequence[int] | None = None,
+) -> str:
+    """Per-frame scoring events: one row per match/switch, miss, false positive, ignored object.
+
+    ``similarity`` is the IoU (IoU gating) or the distance in metres (metric gating) of a
+    match; ``switch`` rows are matches that are id switches. ``frame`` is the frame index,
+    or the input's own frame number (MOTChallenge counts from 1) where given.
+    """
+    rows: list[list[object]] = []
+    numbers = frame_numbers if frame_numbers is not None else [e.frame for e in frames]
+    for events, stamp, f in zip(frames, stamps_ns, numbers, strict=True):
+        for m in events.matches:
+            kind = "switch" if m.id_switch else "match"
+            rows.append(
+                [f, stamp, kind, m.gt_id, m.track_id, f"{m.similarity:.6f}", int(m.recall_error)]
+            )
+        rows += [[f, stamp, "miss", g, "", "", ""] for g in events.misses]
+        rows += [[f, stamp, "fp", "", t, "", ""] for t in events.false_positives]
+        rows += [[f, stamp, "ignored_gt", g, "", "", ""] for g in events.ignored_gt]
+        rows += [[f, stamp, "ignored_track", "", t, "", ""] for t in events.ignored_tracks]
+    return _csv(rows, EVENTS_HEADER)
+
+
 def birds_eye_png(r: SequenceResult, path: Path) -> None:
     """Ground-truth (dashed) and tracked (solid) ground-plane trajectories of one sequence."""
     import matplotlib
@@ -354,12 +393,17 @@ def write_run(
         for r in results:
             (tmp / f"{r.name}.detections.csv").write_text(detections_csv(r), encoding="utf-8")
             (tmp / f"{r.name}.tracks.csv").write_text(tracks_csv(r), encoding="utf-8")
+            if r.scores is not None:
+                (tmp / f"{r.name}.events.csv").write_text(
+                    events_csv(r.scores.frames, r.detections.stamps_ns), encoding="utf-8"
+                )
             birds_eye_png(r, tmp / f"{r.name}.birdseye.png")
         md = [
             f"# rgbd-eval run: {config.method}",
             "",
             f"Gating: {report['evaluation']['gating']} (threshold {report['evaluation']['threshold']}); "
             f"MOTP is the {report['evaluation']['motp']}.",
+            f"Convention: {report['evaluation']['matching']}.",
             "",
         ]
         if any(r.scores is not None for r in results):

@@ -394,7 +394,11 @@ class GroundTruthObject:
     Either ``box2d`` (RGB image) or ``world_xyz`` (world frame) may be missing,
     not both. ``visibility`` is the visible fraction in [0, 1]. ``ignore`` marks
     people that are fully occluded or out of view: they neither count as a miss
-    nor make a false positive when a track sits on them.
+    nor make a false positive when a track sits on them. ``distractor`` says what an
+    ignored object does to a track matched to it: ``True`` drops the track (the
+    MOTChallenge distractor classes); ``False`` only lets the object take part in
+    the matching, and the track stays scored (MOT17's non-person classes and
+    pedestrians with the consider flag 0). It has no effect on scored objects.
     """
 
     frame: int
@@ -404,6 +408,7 @@ class GroundTruthObject:
     world_xyz: tuple[float, float, float] | None
     visibility: float = 1.0
     ignore: bool = False
+    distractor: bool = True
 
     def __post_init__(self) -> None:
         if self.box2d is None and self.world_xyz is None:

@@ -90,3 +90,29 @@ def test_folder_of_recordings_gives_overall_row(tmp_path: Path) -> None:
     # Overall counts are sums, never averages of ratios.
     assert report["overall"]["counts"]["num_gt"] == 5
     assert "overall" in (out / "report.md").read_text()
+
+
+def test_topic_option_chooses_streams_on_run_bench_and_sweep(tmp_path: Path) -> None:
+    rec = write_recording(tmp_path / "topics.mcap", "mcap", Spec(n=3))
+    wrong = "colour=/camera/depth/image_raw"  # a depth topic is no colour image
+    for args in (
+        ["run", str(rec), "--out", str(tmp_path / "o")],
+        ["bench", str(rec), "--repeat", "1", "--all-cores"],
+        ["sweep", "tracker.min_confidence", "0", "--dataset", str(rec), "--jobs", "1"],
+    ):
+        result = runner.invoke(app, [*args, "--topic", wrong])
+        assert result.exit_code == 3, (args[0], result.output)
+        assert "--topic colour=/camera/depth/image_raw: not a colour image topic" in result.output
+    ok = runner.invoke(
+        app,
+        [
+            "run",
+            str(rec),
+            "--out",
+            str(tmp_path / "ok"),
+            "--topic",
+            "colour=/camera/rgb/image_color",
+        ],
+    )
+    assert ok.exit_code == 0, ok.output
+    assert not (tmp_path / "o").exists()

@@ -9,13 +9,16 @@ from __future__ import annotations
 import pytest
 from metrics_builders import gt, track
 
-from rgbd_eval.config import EvaluationConfig, Gating
+from rgbd_eval.config import Convention, EvaluationConfig, Gating
 from rgbd_eval.errors import RgbdEvalError, ScoringError
 from rgbd_eval.metrics import Counts, evaluate_sequence, summarize, total
 from rgbd_eval.types import TrackStatus, Visibility
 
-IOU = EvaluationConfig(gating=Gating.IOU)
-METRIC = EvaluationConfig(gating=Gating.METRIC)
+# The hand-computed counts below follow motmetrics 1.4; test_metrics_conventions.py
+# covers where the motchallenge convention differs.
+MM = Convention.MOTMETRICS
+IOU = EvaluationConfig(gating=Gating.IOU, convention=MM)
+METRIC = EvaluationConfig(gating=Gating.METRIC, convention=MM)
 A = (0.0, 0.0, 10.0, 10.0)  # person A's box
 B = (100.0, 0.0, 10.0, 10.0)  # person B's box
 FAR = (500.0, 500.0, 10.0, 10.0)  # nobody there
@@ -145,7 +148,7 @@ def test_ignored_ground_truth_with_a_track_on_it() -> None:
 def test_low_visibility_is_ignored() -> None:
     gts = [[gt(1, A), gt(2, B, visibility=0.2)]]
     tracks = [[track(7, A), track(8, B)]]
-    c = evaluate_sequence(gts, tracks, EvaluationConfig(min_visibility=0.5)).counts
+    c = evaluate_sequence(gts, tracks, EvaluationConfig(min_visibility=0.5, convention=MM)).counts
     assert (c.num_gt, c.num_matches, c.fp, c.ignored_gt, c.ignored_tracks) == (1, 1, 0, 1, 1)
 
 
@@ -179,7 +182,9 @@ def test_metric_and_iou_gating_match_differently() -> None:
     for scores in (by_iou, by_distance):
         assert (scores.counts.fp, scores.counts.fn) == (1, 1)
     # A wider metric gate (2 m) matches both.
-    wide = evaluate_sequence(gts, tracks, EvaluationConfig(gating=Gating.METRIC, threshold=2.0))
+    wide = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=Gating.METRIC, threshold=2.0, convention=MM)
+    )
     assert wide.counts.num_matches == 2
     assert wide.summary()["motp"] == pytest.approx(1.0)  # (0.5 + 1.5) / 2
 
@@ -235,7 +240,7 @@ def test_previous_match_is_kept_across_a_gap() -> None:
 
 def test_empty_sequence() -> None:
     scores = evaluate_sequence([], [], IOU)
-    assert scores.counts == Counts.empty(Gating.IOU, 0.5)
+    assert scores.counts == Counts.empty(Gating.IOU, 0.5, MM)
     assert scores.frames == ()
     assert scores.summary()["mota"] is None
 

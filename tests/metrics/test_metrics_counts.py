@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from rgbd_eval.config import Gating
+from rgbd_eval.config import Convention, Gating
 from rgbd_eval.metrics.counts import COUNTS_SCHEMA, Counts, summarize, total
 
 
@@ -86,7 +86,7 @@ def test_addition_sums_every_count() -> None:
     b = replace(a, num_frames=1)
     c = a + b
     for f in fields(Counts):
-        if f.name in ("gating", "threshold"):
+        if f.name in ("gating", "threshold", "convention"):
             assert getattr(c, f.name) == getattr(a, f.name)
         else:
             assert getattr(c, f.name) == getattr(a, f.name) + getattr(b, f.name)
@@ -101,6 +101,8 @@ def test_adding_differently_gated_counts_raises() -> None:
         _ = _example() + Counts.empty(Gating.METRIC, 1.0)
     with pytest.raises(ValueError, match=r"threshold=0\.3"):
         _ = _example() + Counts.empty(Gating.IOU, 0.3)
+    with pytest.raises(ValueError, match="convention=motmetrics"):
+        _ = _example() + Counts.empty(Gating.IOU, 0.5, Convention.MOTMETRICS)
     with pytest.raises(ValueError, match="must not be empty"):
         total([])
 

@@ -20,7 +20,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from metrics_builders import gt, track
 
-from rgbd_eval.config import EvaluationConfig, Gating
+from rgbd_eval.config import Convention, EvaluationConfig, Gating
 from rgbd_eval.metrics import Counts, evaluate_sequence
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
@@ -145,7 +145,7 @@ def _close(ours: float | int | None, reference: float) -> bool:
 @given(data=sequences())
 def test_counts_equal_motmetrics(gating: Gating, data: Frames) -> None:
     gts, tracks = data
-    config = EvaluationConfig(gating=gating)
+    config = EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)
     threshold = config.effective_threshold()
     scores = evaluate_sequence(gts, tracks, config)
     c, s = scores.counts, scores.summary()
@@ -213,7 +213,9 @@ def test_a_perfect_tracker_scores_mota_one(
         ]
         for frame in gts
     ]
-    s = evaluate_sequence(gts, tracks, EvaluationConfig(gating=gating)).summary()
+    s = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)
+    ).summary()
     if s["num_gt"] == 0:
         assert s["mota"] is None
         return
@@ -228,7 +230,9 @@ def test_a_perfect_tracker_scores_mota_one(
 @given(data=sequences(with_ignored=True))
 def test_ignored_ground_truth_is_neither_scored_nor_missed(gating: Gating, data: Frames) -> None:
     gts, tracks = data
-    scores = evaluate_sequence(gts, tracks, EvaluationConfig(gating=gating))
+    scores = evaluate_sequence(
+        gts, tracks, EvaluationConfig(gating=gating, convention=Convention.MOTMETRICS)
+    )
     c = scores.counts
     ignored = sum(g.ignore for frame in gts for g in frame)
     scored_tracks = sum(_scored(t) for frame in tracks for t in frame)

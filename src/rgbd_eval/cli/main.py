@@ -11,6 +11,7 @@ from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.methods_cmd import methods
 from rgbd_eval.cli.reproduce_cmd import reproduce
 from rgbd_eval.cli.run import run
+from rgbd_eval.cli.score_cmd import score
 from rgbd_eval.cli.sweep_cmd import sweep
 from rgbd_eval.cli.synth_cmd import synth
 
@@ -29,6 +30,7 @@ app.command("compare")(compare)
 app.command("synth")(synth)
 app.command("reproduce")(reproduce)
 app.command("bench")(bench)
+app.command("score")(score)
 app.command("methods")(methods)
 
 

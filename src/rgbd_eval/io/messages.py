@@ -2,7 +2,9 @@
 
 The ground-truth topic carries ``rgbd_eval_msgs/msg/GroundTruthArray``; its
 definition is registered with every typestore this module hands out, and the
-ROS1 Noetic typestore also gets ``tf2_msgs/msg/TFMessage``, which it lacks.
+ROS1 Noetic typestore also gets ``tf2_msgs/msg/TFMessage``, which it lacks. The
+people-tracker output types ``rgbd-eval score`` reads are registered too
+(:mod:`rgbd_eval.io.track_message_types`).
 """
 
 from __future__ import annotations
@@ -12,6 +14,8 @@ from typing import Literal
 
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.store import Typestore
+
+from rgbd_eval.io.track_message_types import track_message_definitions
 
 GT_PERSON_TYPE = "rgbd_eval_msgs/msg/GroundTruthPerson"
 GT_ARRAY_TYPE = "rgbd_eval_msgs/msg/GroundTruthArray"
@@ -57,6 +61,8 @@ def extra_types(ros_version: RosVersion) -> dict[str, tuple[list[object], list[o
     types.update(get_types_from_msg(GT_ARRAY_MSG, GT_ARRAY_TYPE))  # type: ignore[arg-type]
     if ros_version == 1:
         types.update(get_types_from_msg(TF_MESSAGE_MSG, TF_TYPE))  # type: ignore[arg-type]
+    for name, text in track_message_definitions(ros_version).items():
+        types.update(get_types_from_msg(text, name))  # type: ignore[arg-type]
     return types
 
 

@@ -4,7 +4,13 @@
 ``summarize(total(...))`` derives every ratio for one or many sequences.
 """
 
-from rgbd_eval.metrics.clear import FrameEvents, Match, SequenceScores, evaluate_sequence
+from rgbd_eval.metrics.clear import (
+    FrameEvents,
+    Match,
+    SequenceScores,
+    evaluate_sequence,
+    score_selections,
+)
 from rgbd_eval.metrics.counts import COUNTS_SCHEMA, Counts, Summary, summarize, total
 from rgbd_eval.metrics.gating import (
     distance_matrix,
@@ -13,11 +19,13 @@ from rgbd_eval.metrics.gating import (
     iou_matrix,
     metric_distance_matrix,
 )
+from rgbd_eval.metrics.hota import HotaCounts
 
 __all__ = [
     "COUNTS_SCHEMA",
     "Counts",
     "FrameEvents",
+    "HotaCounts",
     "Match",
     "SequenceScores",
     "Summary",
@@ -27,6 +35,7 @@ __all__ = [
     "iou_distance_matrix",
     "iou_matrix",
     "metric_distance_matrix",
+    "score_selections",
     "summarize",
     "total",
 ]

@@ -1,18 +1,24 @@
 """CLEAR MOT scoring of one sequence (Bernardin & Stiefelhagen 2008; seed 000, 7.3).
 
-Matching convention (that of ``motmetrics.MOTAccumulator``): in every frame, a
-ground-truth object keeps the track it was last matched to whenever that pair is
-still inside the gate, even if the object was unmatched or absent in between and
-even if another track is closer; only the remaining objects and tracks are
-matched by the Hungarian algorithm on the gated distances. A match whose track
-differs from the last track matched to the object, however long ago, is an id
-switch. (TrackEval differs: it favours only the pairs matched in the immediately
-previous frame, so a pair interrupted for one frame may be replaced by a closer
-track there.)
+The matching follows one of two references exactly, chosen by
+``EvaluationConfig.convention`` (see :mod:`rgbd_eval.metrics.matching`):
+``motchallenge`` (the official devkit, as TrackEval reproduces it) or
+``motmetrics`` (py-motmetrics 1.4). The conventions also differ in two counts:
 
-Standard measures (matches, FP, FN, switches, fragmentations, MT/PT/ML, the IDF1
-counts) come from ``motmetrics``; the thesis' Main Tr., the similarity sum and
-Pinto's recall errors are computed here from the same accumulator events.
+- MT/PT/ML: ``motchallenge`` counts an object as mostly tracked when it is
+  matched in more than 80 % of its frames, ``motmetrics`` at 80 % or more; both
+  count mostly lost below 20 %.
+- Fragmentations: ``motchallenge`` counts, per object, the tracked stretches after
+  the first one, where a stretch breaks at any frame (with ground truth and
+  tracks) in which the object is not matched, absent frames included;
+  ``motmetrics`` counts the returns from missed to tracked over the frames the
+  object is present in.
+
+IDF1 (Ristani et al. 2016) is the optimal one-to-one assignment of ground-truth
+ids to track ids over the sequence, counting the frames in which a pair is
+inside the gate; HOTA is computed as TrackEval does (:mod:`rgbd_eval.metrics.hota`).
+The thesis' Main Tr., the similarity sum and Pinto's recall errors come from the
+same matches.
 
 A recall error (seed 001, V-C: "ID switches that occurred by initializing a track
 with an ID that was previously associated with a different person") is an id
@@ -24,40 +30,25 @@ first match is never an id switch, hence never a recall error.
 
 from __future__ import annotations
 
-import functools
-from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import NamedTuple
 
-import motmetrics as mm
+import numpy as np
+from scipy.optimize import linear_sum_assignment
 
-from rgbd_eval.config import EvaluationConfig, Gating
+from rgbd_eval.config import Convention, EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
 from rgbd_eval.metrics.counts import Counts, Summary, summarize
-from rgbd_eval.metrics.gating import distance_matrix, similarity
+from rgbd_eval.metrics.gating import gate, similarity_from_measure
+from rgbd_eval.metrics.hota import hota_counts
+from rgbd_eval.metrics.matching import (
+    IntArray,
+    MotChallengeMatcher,
+    MotMetricsMatcher,
+)
 from rgbd_eval.metrics.selection import FrameSelection, select_frame
 from rgbd_eval.types import GroundTruthObject, TrackOutput
-
-_SOLVER = "scipy"
-#: The motmetrics measures read into :class:`Counts`.
-_STANDARD_METRICS = (
-    "num_frames",
-    "num_objects",
-    "num_predictions",
-    "num_matches",
-    "num_switches",
-    "num_false_positives",
-    "num_misses",
-    "num_fragmentations",
-    "num_unique_objects",
-    "mostly_tracked",
-    "partially_tracked",
-    "mostly_lost",
-    "idtp",
-    "idfp",
-    "idfn",
-)
 
 
 class Match(NamedTuple):
@@ -97,11 +88,6 @@ class SequenceScores:
         return summarize(self.counts)
 
 
-@functools.cache
-def _metrics_host() -> Any:
-    return mm.metrics.create()
-
-
 def evaluate_sequence(
     gt_frames: Sequence[Sequence[GroundTruthObject]],
     track_frames: Sequence[Sequence[TrackOutput]],
@@ -119,117 +105,158 @@ def evaluate_sequence(
             f"ground truth has {len(gt_frames)} frames but the tracker output has "
             f"{len(track_frames)}; they must be index-aligned"
         )
-    gating = config.gating
     threshold = config.effective_threshold()
-    if not gt_frames:
-        return SequenceScores(Counts.empty(gating, threshold), ())
-    # Pin the assignment solver: motmetrics otherwise takes the first one installed
-    # (lapsolver, lap, scipy, ...), and solvers may break ties differently.
-    with mm.lap.set_default_solver(_SOLVER):
-        accumulator = mm.MOTAccumulator(auto_id=True)
-        selections: list[FrameSelection] = []
-        for index, (gt_objects, tracks) in enumerate(zip(gt_frames, track_frames, strict=True)):
-            selection = select_frame(
-                index, gt_objects, tracks, gating, threshold, config.min_visibility
-            )
-            distances = distance_matrix(
-                gating, selection.gt_values, selection.track_values, threshold
-            )
-            accumulator.update(selection.gt_ids, selection.track_ids, distances)
-            selections.append(selection)
-        standard = _metrics_host().compute(
-            accumulator, metrics=list(_STANDARD_METRICS), return_dataframe=False
-        )
-    frames, extras = _read_events(accumulator, selections, gating)
+    selections = [
+        select_frame(index, gt_objects, tracks, config.gating, threshold, config.min_visibility)
+        for index, (gt_objects, tracks) in enumerate(zip(gt_frames, track_frames, strict=True))
+    ]
+    return score_selections(selections, config)
+
+
+def _dense(per_frame: Sequence[Sequence[int]]) -> tuple[list[IntArray], int]:
+    """Per-frame ids as dense indices ``0..K-1`` (in sorted id order), and ``K``."""
+    flat = np.fromiter(
+        (i for ids in per_frame for i in ids), dtype=np.int64, count=sum(map(len, per_frame))
+    )
+    unique, inverse = np.unique(flat, return_inverse=True)
+    bounds = np.cumsum([len(ids) for ids in per_frame])[:-1]
+    return np.split(inverse.astype(np.int64), bounds), len(unique)
+
+
+def score_selections(
+    selections: Sequence[FrameSelection], config: EvaluationConfig
+) -> SequenceScores:
+    """Score frames already split by :func:`~rgbd_eval.metrics.selection.select_frame`."""
+    gating, convention = config.gating, config.convention
+    threshold = config.effective_threshold()
+    if not selections:
+        return SequenceScores(Counts.empty(gating, threshold, convention), ())
+    gts, num_gt = _dense([s.gt_ids for s in selections])
+    # Present tracks include the dropped ones; the scored tracks are their subset.
+    n = len(selections)
+    both, num_tracks = _dense(
+        [s.track_ids for s in selections] + [sorted(s.present_track_ids) for s in selections]
+    )
+    tracks, present = both[:n], both[n:]
+    trackeval = convention is Convention.MOTCHALLENGE
+    mc = MotChallengeMatcher(num_gt)
+    mm = MotMetricsMatcher(num_gt, num_tracks)
+    last_person = np.full(num_tracks, -1, dtype=np.int64)
+    was_present = np.zeros(num_tracks, dtype=bool)
+    similarities = []
+    potential: list[IntArray] = []
+    matched_gt: list[IntArray] = []
+    matched_pairs: list[IntArray] = []
+    frames: list[FrameEvents] = []
+    similarity_sum = 0.0
+    id_switches = recall_errors = 0
+    for i, (sel, g, t) in enumerate(zip(selections, gts, tracks, strict=True)):
+        measure = sel.measure
+        similarity = similarity_from_measure(gating, measure, threshold)
+        similarities.append(similarity)
+        valid = gate(gating, measure, similarity, threshold, exact_trackeval=trackeval)
+        if trackeval:
+            match = mc.step(g, t, similarity, valid)
+        else:
+            distance = 1.0 - measure if gating is Gating.IOU else measure
+            match = mm.step(g, t, distance, valid)
+        rows, cols = np.nonzero(valid)
+        potential.append(g[rows] * num_tracks + t[cols])
+        mg, mt = g[match.rows], t[match.cols]
+        values = measure[match.rows, match.cols]
+        recall = match.switch & (last_person[mt] >= 0) & (last_person[mt] != mg)
+        recall &= ~was_present[mt]
+        last_person[mt] = mg
+        if i:
+            was_present[present[i - 1]] = False
+        was_present[present[i]] = True
+        similarity_sum += float(values.sum())
+        id_switches += int(match.switch.sum())
+        recall_errors += int(recall.sum())
+        matched_gt.append(mg)
+        matched_pairs.append(mg * num_tracks + mt)
+        frames.append(_frame_events(i, sel, match.rows, match.cols, values, match.switch, recall))
+    all_gt = np.concatenate(gts)
+    all_matched = np.concatenate(matched_gt)
+    ratio = np.bincount(all_matched, minlength=num_gt) / np.maximum(
+        1, np.bincount(all_gt, minlength=num_gt)
+    )
+    mostly = ratio > 0.8 if trackeval else ratio >= 0.8
+    partly = ~mostly & (ratio >= 0.2)
+    pair_keys, pair_counts = np.unique(np.concatenate(matched_pairs), return_counts=True)
+    main = np.zeros(num_gt, dtype=np.int64)
+    np.maximum.at(main, pair_keys // max(num_tracks, 1), pair_counts)
+    idtp = _idtp(np.concatenate(potential), num_tracks)
+    num_gt_instances = len(all_gt)
+    num_track_instances = sum(len(x) for x in tracks)
+    hota = hota_counts(gts, tracks, similarities, num_gt, num_tracks)
     counts = Counts(
         gating=gating,
         threshold=threshold,
-        num_frames=int(standard["num_frames"]),
-        num_gt=int(standard["num_objects"]),
-        num_tracks=int(standard["num_predictions"]),
-        num_matches=int(standard["num_matches"] + standard["num_switches"]),
-        fp=int(standard["num_false_positives"]),
-        fn=int(standard["num_misses"]),
-        id_switches=int(standard["num_switches"]),
-        fragmentations=int(standard["num_fragmentations"]),
-        similarity_sum=extras.similarity_sum,
-        num_gt_tracks=int(standard["num_unique_objects"]),
-        mostly_tracked=int(standard["mostly_tracked"]),
-        partly_tracked=int(standard["partially_tracked"]),
-        mostly_lost=int(standard["mostly_lost"]),
-        main_tr_matches=extras.main_tr_matches,
-        idtp=round(float(standard["idtp"])),
-        idfp=round(float(standard["idfp"])),
-        idfn=round(float(standard["idfn"])),
-        recall_errors=extras.recall_errors,
+        convention=convention,
+        num_frames=len(selections),
+        num_gt=num_gt_instances,
+        num_tracks=num_track_instances,
+        num_matches=len(all_matched),
+        fp=num_track_instances - len(all_matched),
+        fn=num_gt_instances - len(all_matched),
+        id_switches=id_switches,
+        fragmentations=mc.fragmentations() if trackeval else mm.frags,
+        similarity_sum=similarity_sum,
+        num_gt_tracks=num_gt,
+        mostly_tracked=int(mostly.sum()),
+        partly_tracked=int(partly.sum()),
+        mostly_lost=int(num_gt - mostly.sum() - partly.sum()),
+        main_tr_matches=int(main.sum()),
+        idtp=idtp,
+        idfp=num_track_instances - idtp,
+        idfn=num_gt_instances - idtp,
+        recall_errors=recall_errors,
         ignored_gt=sum(len(s.ignored_gt_ids) for s in selections),
         ignored_tracks=sum(len(s.dropped_track_ids) for s in selections),
+        hota=hota,
     )
-    return SequenceScores(counts, frames)
+    return SequenceScores(counts, tuple(frames))
 
 
-class _Extras(NamedTuple):
-    similarity_sum: float
-    main_tr_matches: int
-    recall_errors: int
+def _idtp(pair_keys: IntArray, num_tracks: int) -> int:
+    """Identity true positives: the best one-to-one id assignment by frames inside the gate."""
+    if len(pair_keys) == 0:
+        return 0
+    keys, counts = np.unique(pair_keys, return_counts=True)
+    g_rows, g = np.unique(keys // num_tracks, return_inverse=True)
+    t_cols, t = np.unique(keys % num_tracks, return_inverse=True)
+    weights = np.zeros((len(g_rows), len(t_cols)))
+    weights[g, t] = counts
+    rows, cols = linear_sum_assignment(weights, maximize=True)
+    return int(weights[rows, cols].sum())
 
 
-def _read_events(
-    accumulator: Any, selections: list[FrameSelection], gating: Gating
-) -> tuple[tuple[FrameEvents, ...], _Extras]:
-    """Per-frame events plus the counts motmetrics does not provide."""
-    events = accumulator.mot_events
-    events = events[events["Type"].isin(("MATCH", "SWITCH", "MISS", "FP"))]
-    frame_ids = events.index.get_level_values(0).tolist()
-    rows = zip(
-        frame_ids,
-        events["Type"].astype(str).tolist(),
-        events["OId"].tolist(),
-        events["HId"].tolist(),
-        events["D"].tolist(),
-        strict=True,
+def _frame_events(
+    index: int,
+    sel: FrameSelection,
+    rows: IntArray,
+    cols: IntArray,
+    values: np.ndarray,
+    switch: np.ndarray,
+    recall: np.ndarray,
+) -> FrameEvents:
+    matched_rows = set(rows.tolist())
+    matched_cols = set(cols.tolist())
+    return FrameEvents(
+        frame=index,
+        matches=tuple(
+            map(
+                Match,
+                [sel.gt_ids[r] for r in rows.tolist()],
+                [sel.track_ids[c] for c in cols.tolist()],
+                values.tolist(),
+                switch.tolist(),
+                recall.tolist(),
+            )
+        ),
+        misses=tuple(x for k, x in enumerate(sel.gt_ids) if k not in matched_rows),
+        false_positives=tuple(x for k, x in enumerate(sel.track_ids) if k not in matched_cols),
+        ignored_gt=tuple(sel.ignored_gt_ids),
+        ignored_tracks=tuple(sel.dropped_track_ids),
     )
-    matches: list[list[Match]] = [[] for _ in selections]
-    misses: list[list[int]] = [[] for _ in selections]
-    false_positives: list[list[int]] = [[] for _ in selections]
-    pair_frames: Counter[tuple[int, int]] = Counter()
-    last_person: dict[int, int] = {}
-    similarity_sum = 0.0
-    recall_errors = 0
-    for frame, kind, oid, hid, distance in rows:
-        if kind == "MISS":
-            misses[frame].append(int(oid))
-            continue
-        if kind == "FP":
-            false_positives[frame].append(int(hid))
-            continue
-        gt_id, track_id = int(oid), int(hid)
-        switch = kind == "SWITCH"
-        previous = last_person.get(track_id)
-        recall = (
-            switch
-            and previous is not None
-            and previous != gt_id
-            and track_id not in selections[frame - 1].present_track_ids
-        )
-        last_person[track_id] = gt_id
-        recall_errors += recall
-        value = similarity(gating, float(distance))
-        similarity_sum += value
-        pair_frames[gt_id, track_id] += 1
-        matches[frame].append(Match(gt_id, track_id, value, switch, recall))
-    main_frames: dict[int, int] = {}
-    for (gt_id, _), count in pair_frames.items():
-        main_frames[gt_id] = max(main_frames.get(gt_id, 0), count)
-    frames = tuple(
-        FrameEvents(
-            frame=i,
-            matches=tuple(matches[i]),
-            misses=tuple(misses[i]),
-            false_positives=tuple(false_positives[i]),
-            ignored_gt=tuple(s.ignored_gt_ids),
-            ignored_tracks=tuple(s.dropped_track_ids),
-        )
-        for i, s in enumerate(selections)
-    )
-    return frames, _Extras(similarity_sum, sum(main_frames.values()), recall_errors)

@@ -16,13 +16,17 @@ ground-truth instances:
 - ``main_tr``: matches of every ground-truth track by its single most frequent
   track id, summed over tracks, over GT; ``all_tr``: matches by any id over GT,
   i.e. ``1 - fn_rate`` (seed 000, 7.3 and Tables 7.2, 7.3, 7.6).
-- ``mt``/``pt``/``ml``: ground-truth tracks matched in >= 80 %, in [20 %, 80 %),
-  in < 20 % of their scored frames (the motmetrics rules); ``mt_rate`` and
+- ``mt``/``pt``/``ml``: ground-truth tracks matched in most of their scored
+  frames (> 80 % under the ``motchallenge`` convention, >= 80 % under
+  ``motmetrics``), in at least 20 % otherwise, or in fewer; ``mt_rate`` and
   ``ml_rate`` as shares of the ground-truth tracks.
 - ``idf1 = 2 IDTP / (2 IDTP + IDFP + IDFN)``, with ``idp`` and ``idr``.
 - ``recall_errors`` (seed 001, V-C): id switches where a track id that had been
   given up is handed back, on a different person (see :mod:`rgbd_eval.metrics.clear`).
 - ``precision``: matches over scored track instances.
+- ``hota``, ``deta``, ``assa``, ``loca``: TrackEval's HOTA family, averaged over
+  its 19 localisation thresholds (:mod:`rgbd_eval.metrics.hota`); ``None`` for
+  counts that carry no HOTA sums.
 
 Empty cases: a ratio whose denominator is zero is ``None`` (no ground truth:
 ``mota``, ``fp_rate``, ``fn_rate``, ``main_tr``, ``all_tr`` ... are ``None``; no
@@ -33,13 +37,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, field, fields
 
-from rgbd_eval.config import Gating
+from rgbd_eval.config import Convention, Gating
 from rgbd_eval.metrics.gating import check_threshold
+from rgbd_eval.metrics.hota import HotaCounts
 
-#: The version of the :meth:`Counts.to_dict` layout.
-COUNTS_SCHEMA = 1
+#: The version of the :meth:`Counts.to_dict` layout (2: convention and HOTA sums).
+COUNTS_SCHEMA = 2
 
 _FLOAT_TOLERANCE = 1e-6
 
@@ -58,10 +63,13 @@ class Counts:
     frequent track id. ``idtp``/``idfp``/``idfn`` are the identity counts of
     Ristani et al. ``ignored_gt`` counts ignored ground-truth instances and
     ``ignored_tracks`` the track instances dropped because they sat on one.
+    ``convention`` names the matching rules; ``hota`` holds the HOTA sums (all
+    zero when not computed).
     """
 
     gating: Gating
     threshold: float
+    convention: Convention = Convention.MOTCHALLENGE
     num_frames: int = 0
     num_gt: int = 0
     num_tracks: int = 0
@@ -82,10 +90,17 @@ class Counts:
     recall_errors: int = 0
     ignored_gt: int = 0
     ignored_tracks: int = 0
+    hota: HotaCounts = field(default_factory=HotaCounts)
 
     def __post_init__(self) -> None:
         if not isinstance(self.gating, Gating):
             raise ValueError(f"gating={self.gating!r} must be one of {[g.value for g in Gating]}")
+        if not isinstance(self.convention, Convention):
+            raise ValueError(
+                f"convention={self.convention!r} must be one of {[c.value for c in Convention]}"
+            )
+        if not isinstance(self.hota, HotaCounts):
+            raise ValueError(f"hota={self.hota!r} must be HotaCounts")
         check_threshold(self.gating, self.threshold)
         for name in _INT_FIELDS:
             value = getattr(self, name)
@@ -110,6 +125,14 @@ class Counts:
             ("id_switches <= num_matches", self.id_switches <= self.num_matches),
             ("recall_errors <= id_switches", self.recall_errors <= self.id_switches),
             ("num_gt_tracks <= num_gt", self.num_gt_tracks <= self.num_gt),
+            (
+                "hota tp + fn == num_gt and tp + fp == num_tracks (or no HOTA sums)",
+                self.hota == HotaCounts()
+                or all(
+                    tp + fn == self.num_gt and tp + fp == self.num_tracks
+                    for tp, fn, fp in zip(self.hota.tp, self.hota.fn, self.hota.fp, strict=True)
+                ),
+            ),
             ("fragmentations <= num_gt", self.fragmentations <= self.num_gt),
             (
                 "similarity_sum <= num_matches * bound",
@@ -124,23 +147,36 @@ class Counts:
         return 1.0 if self.gating is Gating.IOU else self.threshold
 
     @staticmethod
-    def empty(gating: Gating, threshold: float) -> Counts:
+    def empty(
+        gating: Gating, threshold: float, convention: Convention = Convention.MOTCHALLENGE
+    ) -> Counts:
         """Counts of nothing (the neutral element of ``+``)."""
-        return Counts(gating=gating, threshold=threshold)
+        return Counts(gating=gating, threshold=threshold, convention=convention)
 
     def __add__(self, other: Counts) -> Counts:
         if not isinstance(other, Counts):
             return NotImplemented
-        if other.gating is not self.gating or other.threshold != self.threshold:
+        if (
+            other.gating is not self.gating
+            or other.threshold != self.threshold
+            or other.convention is not self.convention
+        ):
             raise ValueError(
                 f"cannot add counts scored with gating={other.gating.value} "
-                f"threshold={other.threshold} to counts scored with "
-                f"gating={self.gating.value} threshold={self.threshold}"
+                f"threshold={other.threshold} convention={other.convention.value} to counts "
+                f"scored with gating={self.gating.value} threshold={self.threshold} "
+                f"convention={self.convention.value}"
             )
         summed: dict[str, int | float] = {
             name: getattr(self, name) + getattr(other, name) for name in _SUMMED_FIELDS
         }
-        return Counts(gating=self.gating, threshold=self.threshold, **summed)  # type: ignore[arg-type]
+        return Counts(
+            gating=self.gating,
+            threshold=self.threshold,
+            convention=self.convention,
+            hota=self.hota + other.hota,
+            **summed,  # type: ignore[arg-type]
+        )
 
     def __radd__(self, other: object) -> Counts:
         """Lets the built-in ``sum(counts)`` start from its initial 0."""
@@ -148,11 +184,13 @@ class Counts:
             return self
         return NotImplemented
 
-    def to_dict(self) -> dict[str, int | float | str]:
+    def to_dict(self) -> dict[str, object]:
         """A JSON-ready dict; :meth:`from_dict` reads it back exactly."""
-        data: dict[str, int | float | str] = {"schema": COUNTS_SCHEMA}
+        data: dict[str, object] = {"schema": COUNTS_SCHEMA}
         data.update(asdict(self))
         data["gating"] = self.gating.value
+        data["convention"] = self.convention.value
+        data["hota"] = self.hota.to_dict()
         return data
 
     @staticmethod
@@ -172,9 +210,18 @@ class Counts:
             raise ValueError(
                 f"counts: gating={gating_value!r} must be one of {[g.value for g in Gating]}"
             ) from err
+        try:
+            convention = Convention(data["convention"])
+        except ValueError as err:
+            raise ValueError(
+                f"counts: convention={data['convention']!r} must be one of "
+                f"{[c.value for c in Convention]}"
+            ) from err
         ints = {name: data[name] for name in _INT_FIELDS}
         return Counts(
             gating=gating,
+            convention=convention,
+            hota=HotaCounts.from_dict(data["hota"]),
             threshold=_number(data, "threshold"),
             similarity_sum=_number(data, "similarity_sum"),
             **ints,  # type: ignore[arg-type]
@@ -189,7 +236,9 @@ def _number(data: Mapping[str, object], name: str) -> float:
 
 
 _INT_FIELDS = tuple(
-    f.name for f in fields(Counts) if f.name not in ("gating", "threshold", "similarity_sum")
+    f.name
+    for f in fields(Counts)
+    if f.name not in ("gating", "threshold", "convention", "similarity_sum", "hota")
 )
 _SUMMED_FIELDS = (*_INT_FIELDS, "similarity_sum")
 
@@ -222,6 +271,11 @@ def summarize(counts: Counts) -> Summary:
         "main_tr": _ratio(c.main_tr_matches, c.num_gt),
         "all_tr": _ratio(c.num_matches, c.num_gt),
         "precision": _ratio(c.num_matches, c.num_tracks),
+        **(
+            dict.fromkeys(("hota", "deta", "assa", "loca"))
+            if c.hota == HotaCounts()
+            else c.hota.summary()
+        ),
         "idf1": _ratio(2 * c.idtp, 2 * c.idtp + c.idfp + c.idfn),
         "idp": _ratio(c.idtp, c.idtp + c.idfp),
         "idr": _ratio(c.idtp, c.idtp + c.idfn),

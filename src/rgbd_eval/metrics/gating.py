@@ -24,6 +24,8 @@ from rgbd_eval.config import Gating
 
 FloatArray = NDArray[np.float64]
 
+#: Float tolerance of TrackEval's comparisons (``np.finfo("float").eps``).
+EPS = float(np.finfo(np.float64).eps)
 #: IoU a match needs by default: the PASCAL criterion (seed 000, 7.3).
 DEFAULT_IOU_THRESHOLD = 0.5
 #: Ground-plane distance (m) a match may have by default (seed 001, V-B).
@@ -52,18 +54,29 @@ def iou_matrix(gt_boxes: ArrayLike, track_boxes: ArrayLike) -> FloatArray:
     """Intersection over union of every ground-truth box with every track box.
 
     Both inputs are ``(N, 4)`` / ``(M, 4)`` arrays of ``(left, top, width, height)``;
-    the result is ``(N, M)`` in ``[0, 1]``. Two boxes whose union has zero area
-    have IoU 0.
+    the result is ``(N, M)`` in ``[0, 1]``. The arithmetic is TrackEval's
+    (``_calculate_box_ious``, corners first, areas from the corners), so that the
+    values are bit for bit the ones the devkit convention is defined on; a box of
+    zero area has IoU 0 with everything.
     """
-    a = _as_boxes(gt_boxes, "gt_boxes")[:, None, :]
-    b = _as_boxes(track_boxes, "track_boxes")[None, :, :]
-    near = np.maximum(a[..., :2], b[..., :2])  # (N, M, 2): max of left and of top edges
-    far = np.minimum(a[..., :2] + a[..., 2:], b[..., :2] + b[..., 2:])  # min right, bottom
-    overlap = np.maximum(far - near, 0.0)
-    intersection = overlap[..., 0] * overlap[..., 1]
-    union = a[..., 2] * a[..., 3] + b[..., 2] * b[..., 3] - intersection
-    # A zero union means two zero-area boxes, whose intersection is 0 as well.
-    iou: FloatArray = intersection / np.where(union > 0.0, union, 1.0)
+    a = _as_boxes(gt_boxes, "gt_boxes")
+    b = _as_boxes(track_boxes, "track_boxes")
+    ax0, ay0 = a[:, 0:1], a[:, 1:2]
+    ax1, ay1 = ax0 + a[:, 2:3], ay0 + a[:, 3:4]
+    bx0, by0 = b[:, 0], b[:, 1]
+    bx1, by1 = bx0 + b[:, 2], by0 + b[:, 3]
+    width = np.maximum(np.minimum(ax1, bx1) - np.maximum(ax0, bx0), 0.0)
+    height = np.maximum(np.minimum(ay1, by1) - np.maximum(ay0, by0), 0.0)
+    intersection = width * height
+    area_a = (ax1 - ax0) * (ay1 - ay0)
+    area_b = (bx1 - bx0) * (by1 - by0)
+    union = area_a + area_b - intersection
+    intersection[(area_a <= EPS)[:, 0], :] = 0.0
+    intersection[:, area_b <= EPS] = 0.0
+    degenerate = union <= EPS
+    intersection[degenerate] = 0.0
+    union[degenerate] = 1.0
+    iou: FloatArray = intersection / union
     return iou
 
 
@@ -114,3 +127,44 @@ def distance_matrix(
 def similarity(gating: Gating, distance: float) -> float:
     """What MOTP averages for one match: IoU (``1 - distance``) or the distance in metres."""
     return 1.0 - distance if gating is Gating.IOU else distance
+
+
+def measure_matrix(gating: Gating, gt_values: ArrayLike, track_values: ArrayLike) -> FloatArray:
+    """Ungated IoU (IoU gating) or ground-plane distance in metres (metric gating)."""
+    if gating is Gating.IOU:
+        return iou_matrix(gt_values, track_values)
+    return ground_distance_matrix(gt_values, track_values)
+
+
+def similarity_from_measure(gating: Gating, measure: FloatArray, threshold: float) -> FloatArray:
+    """TrackEval's similarity in [0, 1]: IoU, or ``max(0, 1 - d / (2 threshold))``.
+
+    The distance form is TrackEval's Euclidean similarity with its zero distance set
+    to twice the gate, so that similarity 0.5 is exactly the gate distance (TrackEval's
+    default zero distance of 2 m for the default 1 m gate). HOTA and the
+    ``motchallenge`` matching use this similarity.
+    """
+    if gating is Gating.IOU:
+        return measure
+    return np.maximum(0.0, 1.0 - measure / (2.0 * threshold))
+
+
+def similarity_threshold(gating: Gating, threshold: float) -> float:
+    """The similarity a ``motchallenge`` match needs: the IoU threshold, or 0.5 for distances."""
+    return threshold if gating is Gating.IOU else 0.5
+
+
+def gate(
+    gating: Gating,
+    measure: FloatArray,
+    similarity: FloatArray,
+    threshold: float,
+    exact_trackeval: bool,
+) -> NDArray[np.bool_]:
+    """Which pairs may match: TrackEval's ``similarity >= t - eps``, or motmetrics' plain test."""
+    if exact_trackeval:
+        out: NDArray[np.bool_] = similarity >= similarity_threshold(gating, threshold) - EPS
+        return out
+    if gating is Gating.IOU:
+        return measure >= threshold
+    return measure <= threshold

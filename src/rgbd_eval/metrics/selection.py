@@ -2,18 +2,21 @@
 
 - A track is scored when it is ``VALIDATED`` and not ``NOT_VISIBLE``.
 - A ground-truth object is ignored when ``ignore`` is set or its visibility is
-  below ``min_visibility``. Ignored objects neither count as a miss nor make a
-  false positive of a track sitting on them: scored tracks are first matched to
-  the ignored objects (inside the gate, Hungarian, most pairs first, then least
-  total distance) and the matched tracks are dropped from the frame; the rest is
-  scored normally.
+  below ``min_visibility``. Ignored objects count neither as misses nor as
+  matches. As in the MOTChallenge devkit (TrackEval's MOT preprocessing), the
+  scored tracks are matched against all ground truth of the frame, scored and
+  ignored together (one assignment maximising the summed similarity over the
+  pairs inside the gate), and the tracks matched to an ignored *distractor* are
+  dropped from the frame; a track matched to a non-distractor ignored object
+  (MOT17's consider flag 0, non-person classes) stays and may become a false
+  positive. The rest is scored normally.
 - IoU gating needs ``box2d`` on scored tracks and scored ground truth; metric
   gating needs ``world_xyz`` on scored ground truth (tracks always have x, y).
   An ignored object lacking the field (a person out of the image has no box)
   stays ignored and drops no track.
 
-Ids must be unique per frame and smaller than 2**53 in magnitude (motmetrics
-stores them as float64).
+Ids must be unique per frame and smaller than 2**53 in magnitude (motmetrics,
+the parity reference of one convention, stores them as float64).
 """
 
 from __future__ import annotations
@@ -22,11 +25,16 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 from rgbd_eval.config import Gating
 from rgbd_eval.errors import ScoringError
-from rgbd_eval.metrics.gating import FloatArray, distance_matrix
+from rgbd_eval.metrics.gating import (
+    FloatArray,
+    gate,
+    measure_matrix,
+    similarity_from_measure,
+)
+from rgbd_eval.metrics.matching import max_similarity_pairs
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
 _MAX_ID = 2**53
@@ -38,6 +46,7 @@ class FrameSelection:
 
     ``gt_values``/``track_values`` are ``(N, 4)`` boxes (IoU gating) or ``(N, 2)``
     ground-plane positions (metric gating), row-aligned with the ids.
+    ``measure`` is their ungated IoU or ground-plane distance (rows: ground truth).
     ``present_track_ids`` are all scored tracks, including the dropped ones.
     """
 
@@ -45,6 +54,7 @@ class FrameSelection:
     gt_values: FloatArray
     track_ids: list[int]
     track_values: FloatArray
+    measure: FloatArray
     ignored_gt_ids: list[int]
     dropped_track_ids: list[int]
     present_track_ids: frozenset[int]
@@ -129,18 +139,14 @@ def _rows(
 def tracks_on_ignored(
     ignored_values: FloatArray, track_values: FloatArray, gating: Gating, threshold: float
 ) -> list[int]:
-    """Indices of the tracks matched to ignored ground truth (gated Hungarian)."""
+    """Indices of the tracks matched to ignored ground truth when nothing else is present."""
     if len(ignored_values) == 0 or len(track_values) == 0:
         return []
-    distances = distance_matrix(gating, ignored_values, track_values, threshold)
-    valid = np.isfinite(distances)
-    if not valid.any():
-        return []
-    # Invalid pairs cost more than any full set of valid ones, so the assignment
-    # first maximises the number of gated pairs, then minimises their distance.
-    forbidden = (np.nanmax(distances) + 1.0) * (min(distances.shape) + 1)
-    rows, cols = linear_sum_assignment(np.where(valid, distances, forbidden))
-    return sorted(int(c) for r, c in zip(rows, cols, strict=True) if valid[r, c])
+    measure = measure_matrix(gating, ignored_values, track_values)
+    similarity = similarity_from_measure(gating, measure, threshold)
+    valid = gate(gating, measure, similarity, threshold, exact_trackeval=True)
+    _, cols = max_similarity_pairs(valid, similarity)
+    return sorted(int(c) for c in cols)
 
 
 def select_frame(
@@ -152,32 +158,47 @@ def select_frame(
     min_visibility: float,
 ) -> FrameSelection:
     """Split one frame into scored and ignored parts (see the module docstring)."""
-    scored_gt: list[GroundTruthObject] = []
-    ignored_gt: list[GroundTruthObject] = []
-    for gt in gt_objects:
-        (ignored_gt if is_ignored(gt, min_visibility) else scored_gt).append(gt)
-    scored_tracks = [t for t in tracks if is_scored_track(t)]
     _check_ids(frame, "ground-truth", [g.object_id for g in gt_objects])
+    scored_tracks = [t for t in tracks if is_scored_track(t)]
     track_ids, track_values = _track_values(frame, scored_tracks, gating)
     _check_ids(frame, "track", track_ids)
+    ignored_flags = [is_ignored(g, min_visibility) for g in gt_objects]
+    scored_gt = [g for g, ignored in zip(gt_objects, ignored_flags, strict=True) if not ignored]
     gt_ids, gt_values = _gt_values(frame, scored_gt, gating, required=True)
     present = frozenset(track_ids)
-    dropped_ids: list[int] = []
-    if ignored_gt:
-        _, ignored_values = _gt_values(frame, ignored_gt, gating, required=False)
-        dropped = tracks_on_ignored(ignored_values, track_values, gating, threshold)
-        if dropped:
-            keep = np.ones(len(track_ids), dtype=bool)
-            keep[dropped] = False
-            dropped_ids = [track_ids[i] for i in dropped]
-            track_ids = [i for i, k in zip(track_ids, keep.tolist(), strict=True) if k]
-            track_values = track_values[keep]
+    ignored_ids = [g.object_id for g, ign in zip(gt_objects, ignored_flags, strict=True) if ign]
+    if not ignored_ids or not track_ids:
+        measure = measure_matrix(gating, gt_values, track_values)
+        return FrameSelection(
+            gt_ids, gt_values, track_ids, track_values, measure, ignored_ids, [], present
+        )
+    # All ground truth of the frame, in input order, against the scored tracks.
+    joined = [
+        g for g, ign in zip(gt_objects, ignored_flags, strict=True) if not ign or _has(g, gating)
+    ]
+    _, joined_values = _gt_values(frame, joined, gating, required=False)
+    joined_measure = measure_matrix(gating, joined_values, track_values)
+    similarity = similarity_from_measure(gating, joined_measure, threshold)
+    valid = gate(gating, joined_measure, similarity, threshold, exact_trackeval=True)
+    rows, cols = max_similarity_pairs(valid, similarity)
+    distractor = np.array(
+        [is_ignored(g, min_visibility) and g.distractor for g in joined], dtype=bool
+    )
+    dropped = np.zeros(len(track_ids), dtype=bool)
+    dropped[cols[distractor[rows]]] = True
+    scored_rows = np.array([not is_ignored(g, min_visibility) for g in joined], dtype=bool)
+    keep = ~dropped
     return FrameSelection(
         gt_ids=gt_ids,
         gt_values=gt_values,
-        track_ids=track_ids,
-        track_values=track_values,
-        ignored_gt_ids=[g.object_id for g in ignored_gt],
-        dropped_track_ids=dropped_ids,
+        track_ids=[i for i, k in zip(track_ids, keep.tolist(), strict=True) if k],
+        track_values=track_values[keep],
+        measure=joined_measure[scored_rows][:, keep],
+        ignored_gt_ids=ignored_ids,
+        dropped_track_ids=[i for i, d in zip(track_ids, dropped.tolist(), strict=True) if d],
         present_track_ids=present,
     )
+
+
+def _has(gt: GroundTruthObject, gating: Gating) -> bool:
+    return (gt.box2d if gating is Gating.IOU else gt.world_xyz) is not None

@@ -1,0 +1,99 @@
+"""``rgbd-eval score``: score a tracker's recorded output against ground truth."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from rgbd_eval.cli.common import console, handle_errors
+from rgbd_eval.config import load_config
+from rgbd_eval.errors import ConfigError
+
+
+@handle_errors
+def score(
+    tracks: Annotated[
+        Path,
+        typer.Argument(
+            help="tracker output (MOTChallenge .txt, tracks.csv, KTP, a bag with tracks) or a folder"
+        ),
+    ],
+    gt: Annotated[
+        Path, typer.Option(help="ground truth (MOTChallenge gt.txt, CSV sidecar, KTP) or a folder")
+    ],
+    gating: Annotated[
+        str | None, typer.Option(help="'iou' (image boxes) or 'metric' (ground plane)")
+    ] = None,
+    threshold: Annotated[
+        float | None, typer.Option(help="IoU >= x, or distance <= x metres")
+    ] = None,
+    convention: Annotated[
+        str | None,
+        typer.Option(help="'motchallenge' (devkit/TrackEval, default) or 'motmetrics' (1.4)"),
+    ] = None,
+    benchmark: Annotated[
+        str,
+        typer.Option(help="MOTChallenge ground-truth rules: auto, mot15, mot16, mot17, mot20"),
+    ] = "auto",
+    tracks_topic: Annotated[
+        str | None, typer.Option(help="topic of the tracks in a bag (when there are several)")
+    ] = None,
+    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
+    overrides: Annotated[
+        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
+    ] = None,
+    out: Annotated[
+        Path | None, typer.Option(help="output folder (default: runs/<time>-score)")
+    ] = None,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="print report.json on stdout instead of a table")
+    ] = False,
+) -> None:
+    """Score recorded tracker output against ground truth; write the same report as `run`."""
+    from rgbd_eval.io.tracks import Benchmark, sequence_pairs
+    from rgbd_eval.scoring import score_sequence, table_rows, write_report
+
+    sets = list(overrides or [])
+    for key, value in (("gating", gating), ("threshold", threshold), ("convention", convention)):
+        if value is not None:
+            sets.append(f"evaluation.{key}={value}")
+    config = load_config(config_file, sets)
+    try:
+        rules = Benchmark(benchmark)
+    except ValueError as err:
+        known = ", ".join(b.value for b in Benchmark)
+        raise ConfigError(f"--benchmark {benchmark!r}: expected one of {known}") from err
+    max_gap_ns = int(config.io.max_sync_gap_ms * 1e6)
+    sequences = [
+        score_sequence(
+            name, t, g, config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame
+        )
+        for name, t, g in sequence_pairs(tracks, gt)
+    ]
+    out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"
+    report = write_report(out_dir, sequences, config.evaluation, max_gap_ns)
+    if json_out:
+        typer.echo(json.dumps(report, indent=2))
+        return
+    from rgbd_eval.report import table_header
+
+    ev = config.evaluation
+    table = Table(
+        title=f"gating {ev.gating.value} (threshold {ev.effective_threshold()}), "
+        f"convention {ev.convention.value}",
+        title_justify="left",
+    )
+    for i, head in enumerate(table_header()):
+        table.add_column(head, justify="left" if i == 0 else "right")
+    for row in table_rows(sequences, ev.gating):
+        table.add_row(*row, style="bold" if row[0] == "overall" else None)
+    console.print(table)
+    for s in sequences:
+        for w in s.warnings:
+            console.print(f"{s.name}: warning: {w}")
+    console.print(f"report: {out_dir / 'report.md'} (machine-readable: {out_dir / 'report.json'})")

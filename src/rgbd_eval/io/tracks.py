@@ -1,0 +1,440 @@
+"""Tracker output and benchmark ground truth read back for ``rgbd-eval score``.
+
+Tracker output formats (detected from the content):
+
+- MOTChallenge 2D text: ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``
+  (frames from 1; world ``x, y, z`` where they are not ``-1``);
+- our ``tracks.csv`` (``rgbd-eval run`` writes it; a header line names the columns);
+- KTP text (``<stamp>: id x y w h, ...`` or ``<stamp>: id x y z, ...``).
+
+Ground truth: MOTChallenge text, with the devkit's rules for MOT16/17/20
+(TrackEval's ``MotChallenge2DBox`` preprocessing): pedestrians (class 1) with the
+consider flag set are scored; the distractor classes (person on vehicle 2, static
+person 7, distractor 8, reflection 12; MOT20 also non-motorised vehicle 6) are
+ignored and drop the tracks matched to them; everything else is ignored without
+dropping tracks. MOT15 ground truth (no class column) is scored except rows whose
+consider flag is 0. Other
+ground truth goes through :func:`rgbd_eval.io.groundtruth.load_ground_truth`
+(our CSV sidecar, KTP).
+"""
+
+from __future__ import annotations
+
+import configparser
+import csv
+import enum
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rgbd_eval.errors import GroundTruthError, InputError
+from rgbd_eval.io.groundtruth import GroundTruth, from_objects, load_ground_truth, read_ktp
+from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, Visibility
+
+
+class Benchmark(enum.Enum):
+    """Which MOTChallenge ground-truth rules apply (``auto``: MOT17 when classes are present)."""
+
+    AUTO = "auto"
+    MOT15 = "mot15"
+    MOT16 = "mot16"
+    MOT17 = "mot17"
+    MOT20 = "mot20"
+
+
+_PEDESTRIAN = 1
+_DISTRACTORS = {
+    Benchmark.MOT16: frozenset({2, 7, 8, 12}),
+    Benchmark.MOT17: frozenset({2, 7, 8, 12}),
+    Benchmark.MOT20: frozenset({2, 6, 7, 8, 12}),
+}
+
+
+@dataclass(frozen=True)
+class TrackerOutput:
+    """Tracker output of one sequence: (frame, stamp_ns, tracks) sorted by stamp, then frame."""
+
+    source: str
+    frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
+    num_frames: int | None = None
+    """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
+
+
+@dataclass(frozen=True)
+class Aligned:
+    """Ground truth and tracks on one timeline, ready for ``evaluate_sequence``."""
+
+    stamps_ns: tuple[int, ...]
+    frame_numbers: tuple[int, ...]
+    gt: list[list[GroundTruthObject]]
+    tracks: list[list[TrackOutput]]
+    unmatched_track_frames: int
+
+
+# ----------------------------------------------------------------------------- detection
+
+
+def _first_data_line(path: Path) -> str:
+    try:
+        with path.open(encoding="utf-8") as handle:
+            for line in handle:
+                if line.strip() and not line.lstrip().startswith("#"):
+                    return line.strip()
+    except OSError as err:
+        raise InputError(path, f"cannot read ({err.strerror})") from err
+    except UnicodeDecodeError as err:
+        raise InputError(path, "not a text file") from err
+    return ""
+
+
+def is_mot_text(path: Path) -> bool:
+    """Whether a file looks like MOTChallenge text (comma-separated numbers, no header)."""
+    fields = _first_data_line(Path(path)).split(",")
+    if len(fields) < 6:
+        return False
+    try:
+        [float(f) for f in fields]
+    except ValueError:
+        return False
+    return True
+
+
+# ----------------------------------------------------------------------------- MOTChallenge
+
+
+def _mot_rows(path: Path, what: type[Exception]) -> np.ndarray:
+    try:
+        rows = np.loadtxt(path, delimiter=",", ndmin=2, dtype=np.float64)
+    except (OSError, ValueError) as err:
+        message = f"not MOTChallenge text ({err})"
+        raise (
+            GroundTruthError(path, message)
+            if what is GroundTruthError
+            else InputError(path, message)
+        ) from err
+    if rows.size and rows.shape[1] < 6:
+        raise (
+            what(path, "MOTChallenge text needs at least 6 columns")
+            if what is not GroundTruthError
+            else GroundTruthError(path, "MOTChallenge text needs at least 6 columns")
+        )
+    if rows.size and not np.isfinite(rows[:, :6]).all():
+        raise InputError(path, "non-finite frame, id or box value")
+    return rows
+
+
+def seq_length(gt_path: Path) -> int | None:
+    """``seqLength`` from the ``seqinfo.ini`` of a MOTChallenge sequence folder, if any."""
+    for folder in (gt_path.parent, gt_path.parent.parent):
+        ini = folder / "seqinfo.ini"
+        if ini.is_file():
+            parser = configparser.ConfigParser()
+            try:
+                parser.read(ini, encoding="utf-8")
+                return int(parser["Sequence"]["seqLength"])
+            except (KeyError, ValueError, configparser.Error) as err:
+                raise GroundTruthError(ini, f"no integer [Sequence] seqLength ({err})") from err
+    return None
+
+
+def read_mot_tracks(path: Path) -> TrackerOutput:
+    """MOTChallenge tracker output; world x, y, z from columns 8-10 where not -1."""
+    path = Path(path)
+    rows = _mot_rows(path, InputError)
+    by_frame: dict[int, list[TrackOutput]] = {}
+    for row in rows:
+        world = row.shape[0] >= 10 and not np.all(row[7:10] == -1)
+        x, y, z = (float(v) for v in row[7:10]) if world else (math.nan,) * 3
+        if row[4] < 0 or row[5] < 0:
+            raise InputError(path, f"frame {int(row[0])} id {int(row[1])}: negative box size")
+        by_frame.setdefault(int(row[0]), []).append(
+            TrackOutput(
+                track_id=int(row[1]),
+                x=x,
+                y=y,
+                height=2.0 * z if world else math.nan,
+                box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
+                visibility=Visibility.VISIBLE,
+            )
+        )
+    frames = tuple((f, 0, tuple(by_frame[f])) for f in sorted(by_frame))
+    return TrackerOutput(str(path), frames)
+
+
+def _mot_benchmark(rows: np.ndarray, benchmark: Benchmark) -> Benchmark:
+    if benchmark is not Benchmark.AUTO:
+        return benchmark
+    # MOT16/17/20 ground truth has 9 columns (class and visibility in 8 and 9); MOT15 has
+    # 10 (world x, y, z in 8-10, -1 when unknown).
+    has_classes = bool(rows.size) and rows.shape[1] == 9 and bool((rows[:, 7] >= 1).all())
+    return Benchmark.MOT17 if has_classes else Benchmark.MOT15
+
+
+def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTruth:
+    """MOTChallenge ground truth with the devkit's rules (see the module docstring)."""
+    path = Path(path)
+    rows = _mot_rows(path, GroundTruthError)
+    rules = _mot_benchmark(rows, benchmark)
+    if rules is not Benchmark.MOT15 and (rows.size and rows.shape[1] < 8):
+        raise GroundTruthError(path, f"{rules.value} ground truth needs the class column (8)")
+    objects = []
+    for row in rows:
+        frame, oid = int(row[0]), int(row[1])
+        ignore, distractor, visibility = False, True, 1.0
+        world = None
+        if rules is Benchmark.MOT15:
+            if row.shape[0] >= 10 and not np.all(row[7:10] == -1):
+                world = (float(row[7]), float(row[8]), float(row[9]))
+            # TrackEval drops MOT15 rows whose consider flag is 0 (no distractor matching).
+            ignore, distractor = row.shape[0] >= 7 and row[6] == 0, False
+        if rules is not Benchmark.MOT15:
+            cls = int(row[7])
+            scored = cls == _PEDESTRIAN and row[6] != 0
+            ignore = not scored
+            distractor = cls in _DISTRACTORS[rules]
+            if row.shape[0] >= 9:
+                visibility = min(1.0, max(0.0, float(row[8])))
+        objects.append(
+            GroundTruthObject(
+                frame=frame,
+                stamp_ns=0,
+                object_id=oid,
+                box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
+                world_xyz=world,
+                visibility=visibility,
+                ignore=ignore,
+                distractor=distractor,
+            )
+        )
+    return from_objects(str(path), objects)
+
+
+# ----------------------------------------------------------------------------- tracks.csv, KTP
+
+_TRACKS_CSV_REQUIRED = ("frame", "id", "bb_left", "bb_top", "bb_width", "bb_height", "x", "y")
+
+
+def _float(text: str | None) -> float | None:
+    if text is None or text.strip() == "":
+        return None
+    return float(text)
+
+
+def read_tracks_csv(path: Path) -> TrackerOutput:
+    """Our ``tracks.csv``: frame, id, box, world x/y/z, stamp, height, visibility, status."""
+    from rgbd_eval.types import TrackStatus
+
+    path = Path(path)
+    try:
+        with path.open(encoding="utf-8", newline="") as handle:
+            reader = csv.DictReader(handle)
+            missing = [c for c in _TRACKS_CSV_REQUIRED if c not in (reader.fieldnames or [])]
+            if missing:
+                raise InputError(path, f"tracks CSV lacks the column(s) {missing}")
+            by_frame: dict[int, tuple[int, list[TrackOutput]]] = {}
+            for number, row in enumerate(reader, start=2):
+                try:
+                    box = [_float(row[k]) for k in _TRACKS_CSV_REQUIRED[2:6]]
+                    stamp = int(row.get("stamp_ns") or 0)
+                    z = _float(row.get("z"))
+                    height = _float(row.get("height"))
+                    track = TrackOutput(
+                        track_id=int(row["id"]),
+                        x=float(row["x"]),
+                        y=float(row["y"]),
+                        height=height
+                        if height is not None
+                        else (2 * z if z is not None else math.nan),
+                        box2d=None if any(v is None for v in box) else Box2D(*box),  # type: ignore[arg-type]
+                        visibility=Visibility[(row.get("visibility") or "visible").upper()],
+                        status=TrackStatus(row.get("status") or "validated"),
+                    )
+                except (ValueError, KeyError) as err:
+                    raise InputError(path, f"line {number}: {err}") from err
+                frame = int(row["frame"])
+                entry = by_frame.setdefault(frame, (stamp, []))
+                if entry[0] != stamp:
+                    raise InputError(path, f"line {number}: frame {frame} has two stamps")
+                entry[1].append(track)
+    except OSError as err:
+        raise InputError(path, f"cannot read ({err.strerror})") from err
+    frames = tuple(
+        (f, s, tuple(t)) for f, (s, t) in sorted(by_frame.items(), key=lambda i: (i[1][0], i[0]))
+    )
+    return TrackerOutput(str(path), frames)
+
+
+def read_ktp_tracks(path: Path) -> TrackerOutput:
+    """KTP text used for tracker output: boxes, or 3D positions (x, y on the ground)."""
+    try:
+        parsed = read_ktp(path)
+    except GroundTruthError as err:
+        raise InputError(path, str(err).split(": ", 1)[-1]) from err
+    frames = tuple(
+        (
+            f,
+            s,
+            tuple(
+                TrackOutput(
+                    track_id=o.object_id,
+                    x=o.world_xyz[0] if o.world_xyz else math.nan,
+                    y=o.world_xyz[1] if o.world_xyz else math.nan,
+                    height=2 * o.world_xyz[2] if o.world_xyz else math.nan,
+                    box2d=o.box2d,
+                    visibility=Visibility.VISIBLE,
+                )
+                for o in objs
+            ),
+        )
+        for f, s, objs in parsed.frames
+    )
+    return TrackerOutput(str(path), frames)
+
+
+RECORDING_SUFFIXES = (".bag", ".mcap", ".db3")
+
+
+def is_recording(path: Path) -> bool:
+    """Whether ``path`` is a ROS1 bag, an MCAP/db3 file or a ROS2 bag folder."""
+    return (path.is_file() and path.suffix in RECORDING_SUFFIXES) or (
+        path.is_dir() and (path / "metadata.yaml").is_file()
+    )
+
+
+def load_tracks(
+    path: Path, topic: str | None = None, world_frame: str | None = None
+) -> TrackerOutput:
+    """Tracker output from a file or recording, its format detected from the content.
+
+    ``topic`` and ``world_frame`` apply to recordings (see
+    :mod:`rgbd_eval.io.track_messages`).
+    """
+    path = Path(path)
+    if is_recording(path):
+        from rgbd_eval.io.track_messages import read_bag_tracks
+
+        return read_bag_tracks(path, topic, world_frame)
+    if not path.is_file():
+        raise InputError(path, "tracker output not found")
+    if is_mot_text(path):
+        return read_mot_tracks(path)
+    if "," in _first_data_line(path) and ":" not in _first_data_line(path):
+        return read_tracks_csv(path)
+    return read_ktp_tracks(path)
+
+
+def load_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> tuple[GroundTruth, int | None]:
+    """Ground truth for scoring and the sequence length where a ``seqinfo.ini`` states it."""
+    path = Path(path)
+    if not path.is_file():
+        raise GroundTruthError(path, "ground-truth file not found")
+    if is_mot_text(path):
+        return read_mot_gt(path, benchmark), seq_length(path)
+    return load_ground_truth(path), None
+
+
+# ----------------------------------------------------------------------------- alignment
+
+
+def _by_frame_number(gt: GroundTruth, tracks: TrackerOutput, length: int | None) -> Aligned:
+    gt_frames = {f: list(objs) for f, _, objs in gt.frames}
+    track_frames = {f: list(t) for f, _, t in tracks.frames}
+    numbers = set(gt_frames) | set(track_frames)
+    first = 1 if length is not None else min(numbers, default=0)
+    last = max(max(numbers, default=0), first + length - 1 if length is not None else 0)
+    timeline = range(first, last + 1) if numbers or length else range(0)
+    return Aligned(
+        stamps_ns=tuple(0 for _ in timeline),
+        frame_numbers=tuple(timeline),
+        gt=[gt_frames.get(f, []) for f in timeline],
+        tracks=[track_frames.get(f, []) for f in timeline],
+        unmatched_track_frames=0,
+    )
+
+
+def align(
+    gt: GroundTruth, tracks: TrackerOutput, max_gap_ns: int, length: int | None = None
+) -> Aligned:
+    """Put ground truth and tracks on one timeline.
+
+    When either side has no stamps (all 0) both are matched by frame number, over
+    every frame from the first to the last (or ``length`` frames from 1). Otherwise
+    the annotated frames are the timeline and each tracker frame goes to the
+    annotated frame nearest in stamp within ``max_gap_ns``; tracker frames with no
+    annotated frame that near are counted in ``unmatched_track_frames``.
+    """
+    if all(s == 0 for _, s, _ in gt.frames) or all(s == 0 for _, s, _ in tracks.frames):
+        return _by_frame_number(gt, tracks, length)
+    stamps = np.array([s for _, s, _ in gt.frames], dtype=np.int64)
+    out: list[list[TrackOutput]] = [[] for _ in gt.frames]
+    taken: set[int] = set()
+    unmatched = 0
+    for _, stamp, frame_tracks in tracks.frames:
+        j = int(np.searchsorted(stamps, stamp))
+        candidates = [k for k in (j - 1, j) if 0 <= k < len(stamps)]
+        k = min(candidates, key=lambda c: abs(int(stamps[c]) - stamp))
+        if abs(int(stamps[k]) - stamp) <= max_gap_ns and k not in taken:
+            out[k] = list(frame_tracks)
+            taken.add(k)
+        else:
+            unmatched += 1
+    return Aligned(
+        stamps_ns=tuple(int(s) for s in stamps),
+        frame_numbers=tuple(f for f, _, _ in gt.frames),
+        gt=[list(objs) for _, _, objs in gt.frames],
+        tracks=out,
+        unmatched_track_frames=unmatched,
+    )
+
+
+def sequence_pairs(tracks: Path, gt: Path) -> list[tuple[str, Path, Path]]:
+    """(name, tracks file, ground-truth file) for a file pair or a folder of tracker output.
+
+    In a folder, ``<name>.txt`` / ``<name>.csv`` / ``<name>.tracks.csv`` pairs with the
+    first of ``GT/<name>/gt/gt.txt``, ``GT/<name>.gt.csv``, ``GT/<name>.txt``,
+    ``GT/<name>.csv`` that exists.
+    """
+    if not tracks.is_dir() or is_recording(tracks):
+        if gt.is_dir():
+            raise GroundTruthError(gt, "a folder of ground truth needs a folder of tracker output")
+        return [(_name(tracks), tracks, gt)]
+    if not gt.is_dir():
+        raise GroundTruthError(gt, "a folder of tracker output needs a folder of ground truth")
+    # A `run` output folder also holds detections and events CSVs: not tracker output.
+    files = sorted(
+        p
+        for p in tracks.iterdir()
+        if (p.is_file() and p.suffix in (".txt", ".csv") and not p.name.endswith(_NOT_TRACKS))
+        or is_recording(p)
+    )
+    if not files:
+        raise InputError(tracks, "folder holds no tracker output (.txt, .csv or recordings)")
+    pairs = []
+    for f in files:
+        name = _name(f)
+        options = (
+            gt / name / "gt" / "gt.txt",
+            gt / f"{name}.gt.csv",
+            gt / f"{name}.txt",
+            gt / f"{name}.csv",
+        )
+        found = next((o for o in options if o.is_file()), None)
+        if found is None:
+            raise GroundTruthError(
+                gt, f"no ground truth for sequence {name!r} (tried {options[0].name}, ...)"
+            )
+        pairs.append((name, f, found))
+    return pairs
+
+
+_NOT_TRACKS = (".detections.csv", ".events.csv")
+
+
+def _name(path: Path) -> str:
+    name = path.name
+    for suffix in (".tracks.csv", ".csv", ".txt", *RECORDING_SUFFIXES):
+        if name.endswith(suffix):
+            return name[: -len(suffix)]
+    return path.stem
