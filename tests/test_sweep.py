@@ -120,6 +120,9 @@ def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: P
         4,
         "error: --cluster 'local:0': N in local:N must be at least 1",
     )
+    # The hidden --jobs N of old scripts is --cluster local:N; not both.
+    result = CliRunner().invoke(app, [*args, "--jobs", "2", "--cluster", "tcp://h:1"])
+    assert result.exit_code == 4 and "--jobs and --cluster: give one" in result.output
     result = CliRunner().invoke(app, [*args, "--cache-mode", "nfs"])
     assert result.exit_code == 4 and "expected shared or client" in result.output
     assert not (tmp_path / "o").exists()

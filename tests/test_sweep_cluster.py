@@ -154,9 +154,12 @@ def test_a_bad_recording_fails_its_points_and_the_others_complete(
         args += ["--dataset", str(path)]
     out = tmp_path / "out"
     result = CliRunner().invoke(app, [*args, "--cache", str(tmp_path / "c"), "--out", str(out)])
-    # Exit code of the failure (3: bad input recording); the summary counts the failures.
+    # Exit code of the failure (3: bad input recording); one line counts the failures and
+    # names the first in grid order.
     assert result.exit_code == 3, result.output
-    assert "3 of 6 sweep point(s) failed" in result.output
+    error = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(error) == 1 and error[0].startswith("error: 3 of 6 sweep point(s) failed")
+    assert f"first: tracker.min_confidence={VALUES[0]} on broken:" in error[0]
     report = json.loads((out / "sweep.json").read_text())
     assert [
         (f["tracker.min_confidence"], f["sequence"], f["exit_code"]) for f in report["failures"]
@@ -165,6 +168,13 @@ def test_a_bad_recording_fails_its_points_and_the_others_complete(
     good = [(r["tracker.min_confidence"], r["num_matches"]) for r in report["records"]]
     want = [(r.point["tracker.min_confidence"], r.counts.num_matches) for r in reference.records]
     assert good == [w for w in want if w in good] and len(good) == len(VALUES)
+    # When every point fails there is nothing to report: one error line, no output folder.
+    alone = [*args[: args.index("--dataset")], "--dataset", str(bad), "--out", str(tmp_path / "o2")]
+    result = CliRunner().invoke(app, alone)
+    assert result.exit_code == 3
+    error = [line for line in result.output.splitlines() if line.startswith("error:")]
+    assert len(error) == 1 and error[0].startswith("error: 3 of 3 sweep point(s) failed; first:")
+    assert not (tmp_path / "o2").exists()
 
 
 def test_run_over_a_folder_on_two_workers(tmp_path: Path, client2: Any) -> None:

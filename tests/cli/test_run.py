@@ -98,7 +98,7 @@ def test_topic_option_chooses_streams_on_run_bench_and_sweep(tmp_path: Path) -> 
     for args in (
         ["run", str(rec), "--out", str(tmp_path / "o")],
         ["bench", str(rec), "--repeat", "1", "--all-cores"],
-        ["sweep", "tracker.min_confidence", "0", "--dataset", str(rec), "--jobs", "1"],
+        ["sweep", "tracker.min_confidence", "0", "--dataset", str(rec), "--cluster", "local:1"],
     ):
         result = runner.invoke(app, [*args, "--topic", wrong])
         assert result.exit_code == 3, (args[0], result.output)

@@ -36,6 +36,19 @@ SCHEMA_VERSION = 1
 CLUSTER_HELP = (
     "where tasks run: local (one worker per usable CPU), local:N, or tcp://scheduler:8786"
 )
+#: ``--jobs N``, the option before Dask, kept hidden for old scripts: ``--cluster local:N``.
+JobsOption = Annotated[int | None, typer.Option(hidden=True, help="same as --cluster local:N")]
+
+
+def cluster_of(cluster: str, jobs: int | None) -> str:
+    """``--cluster``, or ``local:N`` from the hidden ``--jobs N``."""
+    if jobs is None:
+        return cluster
+    if cluster != "local":
+        raise ConfigError("--jobs and --cluster: give one (--jobs N is --cluster local:N)")
+    return f"local:{jobs}"
+
+
 CACHE_MODE_HELP = (
     "shared: workers use the cache folder (same path everywhere); "
     "client: only this process does (workers share no disk)"

@@ -8,7 +8,14 @@ from typing import Annotated
 
 import typer
 
-from rgbd_eval.cli.common import CLUSTER_HELP, console, err_console, handle_errors
+from rgbd_eval.cli.common import (
+    CLUSTER_HELP,
+    JobsOption,
+    cluster_of,
+    console,
+    err_console,
+    handle_errors,
+)
 
 
 @handle_errors
@@ -20,6 +27,7 @@ def reproduce(
         Path | None, typer.Option(help="output folder (default runs/reproduce-<method>-<time>)")
     ] = None,
     cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
+    jobs: JobsOption = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
     data: Annotated[
         Path | None,
@@ -44,7 +52,7 @@ def reproduce(
         for name in spec.scenarios
     }
     out_dir = out or Path("runs") / f"reproduce-{system}-{time.strftime('%Y%m%d-%H%M%S')}"
-    with connect(parse_cluster(cluster)) as client:
+    with connect(parse_cluster(cluster_of(cluster, jobs))) as client:
         options = ReproduceOptions(
             client=client, cache=cache, progress=lambda m: err_console.print(m)
         )

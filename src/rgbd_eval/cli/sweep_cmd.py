@@ -15,7 +15,9 @@ from rgbd_eval.cli.common import (
     CACHE_MODE_HELP,
     CLUSTER_HELP,
     SCHEMA_VERSION,
+    JobsOption,
     TopicOption,
+    cluster_of,
     console,
     err_console,
     handle_errors,
@@ -75,6 +77,18 @@ def _csv(rows: list[dict[str, Any]]) -> str:
     return buf.getvalue()
 
 
+def _failed(result: SweepResult, where: str) -> TaskError:
+    """One line: how many (point, sequence) tasks failed, and the first failure in grid order."""
+    first = result.failures[0]
+    label = ", ".join(f"{k}={v}" for k, v in first.point.items())
+    n, units = len(result.failures), len(result.failures) + len(result.records)
+    return TaskError(
+        f"{n} of {units} sweep point(s) failed{where}; first: {label} on {first.sequence}: "
+        f"{first.error}",
+        first.exit_code,
+    )
+
+
 @handle_errors
 def sweep(
     param: Annotated[
@@ -96,6 +110,7 @@ def sweep(
     ] = None,
     gating: Annotated[str | None, typer.Option(help="'iou' or 'metric'")] = None,
     cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
+    jobs: JobsOption = None,
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
@@ -153,7 +168,7 @@ def sweep(
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
     mode = parse_cache_mode(cache_mode)
     DetectionCache(cache)  # refuses a cache path that is a file before a cluster starts
-    spec = parse_cluster(cluster, tasks=len(grid) * len(recordings))
+    spec = parse_cluster(cluster_of(cluster, jobs), tasks=len(grid) * len(recordings))
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
     start = time.perf_counter()
     with connect(spec) as client, progress_bar() as bar:
@@ -170,6 +185,8 @@ def sweep(
     wall = time.perf_counter() - start
     for warning in result.warnings:
         err_console.print(f"warning: {warning}", markup=False, highlight=False)
+    if not result.records:  # nothing scored: no output folder, one error line
+        raise _failed(result, "")
     rows = result.rows()
     out_dir.mkdir(parents=True, exist_ok=True)
     write_text(out_dir / "sweep.csv", _csv(rows))
@@ -228,12 +245,4 @@ def sweep(
         f"{result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
     )
     if result.failures:
-        for f in result.failures:
-            label = ", ".join(f"{k}={v}" for k, v in f.point.items())
-            err_console.print(f"failed: {label} on {f.sequence}: {f.error}", markup=False)
-        n = len(result.failures)
-        units = n + len(result.records)
-        raise TaskError(
-            f"{n} of {units} sweep point(s) failed (listed above and in {out_dir / 'sweep.json'})",
-            result.failures[0].exit_code,
-        )
+        raise _failed(result, f"; all are listed in {out_dir / 'sweep.json'}")
