@@ -7,7 +7,7 @@ BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 DEMO   := datasets/demo.mcap
 
-.PHONY: setup system-deps run test test-fast lint datasets bench clean
+.PHONY: setup system-deps test-deps run test test-fast lint datasets bench clean
 
 # open3d needs the system library libusb-1.0 to import on a bare Debian machine.
 system-deps:
@@ -15,6 +15,14 @@ system-deps:
 		echo "installing libusb-1.0 (needed by open3d)"; \
 		SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
 		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq libusb-1.0-0 >/dev/null; \
+	fi
+
+# The HTML report tests open each page in a real headless browser (Debian's chromium).
+test-deps:
+	@if ! command -v chromium >/dev/null 2>&1; then \
+		echo "installing chromium (headless browser for the HTML report tests)"; \
+		SUDO=$$([ "$$(id -u)" = 0 ] || echo sudo); \
+		$$SUDO apt-get update -qq && $$SUDO apt-get install -y -qq -o DPkg::Lock::Timeout=900 --no-install-recommends chromium >/dev/null; \
 	fi
 
 $(STAMP): pyproject.toml
@@ -55,7 +63,7 @@ bench: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval bench runs/bench/demo_raw.bag --repeat 3 --json > runs/bench/demo_raw_bag.json
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
 
-test: $(STAMP)
+test: $(STAMP) test-deps
 	$(BIN)/python -m pytest -q
 
 test-fast: $(STAMP)

@@ -161,7 +161,7 @@ def test_checksummed_garbage_and_foreign_keys_are_misses(tmp_path: Path) -> None
 def test_cache_folder_that_is_a_file(tmp_path: Path) -> None:
     target = tmp_path / "cache"
     target.write_text("not a folder")
-    with pytest.raises(CacheError, match="exists and is not a folder"):
+    with pytest.raises(CacheError, match="is a file, not a detection cache folder"):
         DetectionCache(target)
     # A file where the entry's sub-folder should be: a one-line CacheError on store.
     root = tmp_path / "ok"

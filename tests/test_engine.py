@@ -63,7 +63,7 @@ def test_every_error_survives_the_trip_back_from_a_worker() -> None:
         errors.TopicError("a.bag", "no depth topic"),
         errors.GroundTruthError("a.gt.csv", "short row"),
         errors.TaskError("2 of 6 sweep point(s) failed", 3),
-        errors.CacheError("detection cache c: exists and is not a folder"),
+        errors.CacheError("c", "is a file, not a detection cache folder"),
         errors.ClusterError("cannot reach the scheduler"),
         errors.ScoringError("nothing to score"),
     ]

@@ -62,6 +62,8 @@ def test_outside_method_runs_through_every_command(toy_recording: Path, tmp_path
     assert seq["metrics"] is not None and seq["counts"]["num_gt"] > 0
     # two people, clean synthetic depth: the toy finds and follows both most of the time
     assert seq["metrics"]["mota"] > 0.5
+    # report.html has no colour image to draw the worst frames on, and says so
+    assert "the method reads no colour stream" in (tmp_path / "out" / "report.html").read_text()
 
     sweep = _cli(
         "sweep", "tracker.gate_m", "0.25", "1.0", "--method", "toy",

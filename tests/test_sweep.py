@@ -113,7 +113,7 @@ def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: P
     result = CliRunner().invoke(app, [*args, "--cache", str(tmp_path / "cache")])
     assert result.exit_code == 7
     assert result.output.strip().splitlines() == [
-        f"error: detection cache {tmp_path / 'cache'}: exists and is not a folder"
+        f"error: {tmp_path / 'cache'}: is a file, not a detection cache folder"
     ]
     result = CliRunner().invoke(app, [*args, "--cluster", "local:0"])
     assert (result.exit_code, result.output.strip()) == (

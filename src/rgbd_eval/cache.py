@@ -200,7 +200,7 @@ class DetectionCache:
     def __init__(self, root: Path | None = None) -> None:
         self.root = Path(root) if root is not None else default_cache_dir()
         if self.root.exists() and not self.root.is_dir():
-            raise CacheError(f"detection cache {self.root}: exists and is not a folder")
+            raise CacheError(self.root, "is a file, not a detection cache folder")
 
     def path(self, key: str) -> Path:
         """Where the entry of ``key`` lives."""
@@ -241,5 +241,5 @@ class DetectionCache:
             with contextlib.suppress(OSError):
                 tmp.unlink()
             raise CacheError(
-                f"detection cache {self.root}: cannot write {path.name} ({err.strerror or err})"
+                path, f"cannot write this detection cache entry ({err.strerror or err})"
             ) from err

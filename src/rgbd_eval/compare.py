@@ -124,10 +124,11 @@ def _status(base: float | None, cur: float | None, better: Better, tol: float) -
     return Status.REGRESSED if -gain > tol + 1e-12 else Status.WORSE
 
 
-def _flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
+def flatten(prefix: str, value: Any, out: dict[str, Any]) -> None:
+    """Nested mappings -> ``out[dotted.key] = leaf`` (configs compared key by key)."""
     if isinstance(value, Mapping):
         for k, v in value.items():
-            _flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
+            flatten(f"{prefix}.{k}" if prefix else str(k), v, out)
     else:
         out[prefix] = value
 
@@ -189,8 +190,8 @@ def compare_reports(
             deltas.append(Delta(seq, metric, b, c, tol, _status(b, c, better, tol)))
     flat_b: dict[str, Any] = {}
     flat_c: dict[str, Any] = {}
-    _flatten("", baseline.get("config", {}), flat_b)
-    _flatten("", current.get("config", {}), flat_c)
+    flatten("", baseline.get("config", {}), flat_b)
+    flatten("", current.get("config", {}), flat_c)
     changes = tuple(
         f"{k}: {flat_b.get(k)!r} -> {flat_c.get(k)!r}"
         for k in sorted(set(flat_b) | set(flat_c))

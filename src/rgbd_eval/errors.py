@@ -14,7 +14,8 @@ Exit codes (also in README.md):
 4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
-7     an output cannot be written: the detection cache folder is a file or not writable
+7     an output could not be written (e.g. no MP4 encoder for ``--video``; a detection
+      cache folder that is a file or not writable)
 8     the Dask cluster cannot be reached, or a task killed every worker it ran on
 ====  =====================================================================
 """
@@ -77,12 +78,6 @@ class ConfigError(RgbdEvalError):
     exit_code = 4
 
 
-class CacheError(RgbdEvalError):
-    """The detection cache folder cannot be used (a file, not writable)."""
-
-    exit_code = 7
-
-
 class GroundTruthError(RgbdEvalError):
     """Ground truth is missing, unreadable or contradictory."""
 
@@ -105,6 +100,16 @@ class CompareInputError(RgbdEvalError):
     exit_code = 2
 
 
+class OutputError(RgbdEvalError):
+    """An output file could not be written."""
+
+    exit_code = 7
+
+    def __init__(self, path: Path | str, message: str) -> None:
+        self.path = Path(path)
+        super().__init__(f"{self.path}: {message}")
+
+
 class ClusterError(RgbdEvalError):
     """The Dask scheduler cannot be reached, or a task lost every worker that ran it."""
 
@@ -117,3 +122,7 @@ class TaskError(RgbdEvalError):
     def __init__(self, message: str, exit_code: int) -> None:
         super().__init__(message)
         self.exit_code = exit_code
+
+
+class CacheError(OutputError):
+    """The detection cache folder cannot be used (a file, not writable)."""

@@ -1,4 +1,4 @@
-"""Reports of runs: JSON for machines, Markdown and terminal tables for people, CSVs, plots.
+"""Reports of runs: JSON for machines, Markdown and terminal tables for people, CSVs.
 
 A run's output folder is written under a temporary name and renamed when
 complete, so a failed run never leaves a half-written ``report.json`` that a
@@ -13,7 +13,7 @@ import io
 import os
 import shutil
 import tempfile
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import asdict
 from importlib import metadata
@@ -322,45 +322,6 @@ def events_csv(
     return _csv(rows, EVENTS_HEADER)
 
 
-def birds_eye_png(r: SequenceResult, path: Path) -> None:
-    """Ground-truth (dashed) and tracked (solid) ground-plane trajectories of one sequence."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(7, 6), dpi=100)
-    cmap = plt.get_cmap("tab10")
-    if r.ground_truth is not None:
-        paths: dict[int, list[tuple[float, float]]] = {}
-        for frame in r.ground_truth.frames:
-            for o in frame:
-                if o.world_xyz is not None and not o.ignore:
-                    paths.setdefault(o.object_id, []).append((o.world_xyz[0], o.world_xyz[1]))
-        for k, (oid, pts) in enumerate(sorted(paths.items())):
-            xs, ys = zip(*pts, strict=True)
-            ax.plot(xs, ys, "--", color="0.5", lw=1.5, label="ground truth" if k == 0 else None)
-            ax.annotate(f"gt {oid}", pts[0], color="0.4", fontsize=8)
-    tracks: dict[int, list[tuple[float, float]]] = {}
-    for frame_tracks in r.tracks:
-        for t in frame_tracks:
-            if t.visibility.name != "NOT_VISIBLE" and t.status.value == "validated":
-                tracks.setdefault(t.track_id, []).append((t.x, t.y))
-    for tid, pts in sorted(tracks.items()):
-        xs, ys = zip(*pts, strict=True)
-        ax.plot(xs, ys, "-", color=cmap(tid % 10), lw=1.2, label=f"track {tid}")
-    ax.set_xlabel(f"x [m] ({r.info.world_frame})")
-    ax.set_ylabel(f"y [m] ({r.info.world_frame})")
-    ax.set_title(f"{r.name}: bird's-eye view")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
-    if tracks or r.ground_truth is not None:
-        ax.legend(fontsize=7, loc="best", ncol=2)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
-
 @contextmanager
 def staged_output(out_dir: Path) -> Iterator[Path]:
     """A temporary folder beside ``out_dir`` that replaces it only if the block succeeds."""
@@ -382,9 +343,16 @@ def staged_output(out_dir: Path) -> Iterator[Path]:
 
 
 def write_run(
-    out_dir: Path, results: Sequence[SequenceResult], config: RunConfig
+    out_dir: Path,
+    results: Sequence[SequenceResult],
+    config: RunConfig,
+    also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write every output of a run into ``out_dir`` (atomically as a folder); return the report."""
+    """Write every output of a run into ``out_dir`` (atomically as a folder); return the report.
+
+    ``also(folder, report)`` writes further outputs (the HTML page and its plots) into the
+    staged folder.
+    """
     import json
 
     digests = [file_digest(Path(r.path)) for r in results]
@@ -397,7 +365,6 @@ def write_run(
                 (tmp / f"{r.name}.events.csv").write_text(
                     events_csv(r.scores.frames, r.detections.stamps_ns), encoding="utf-8"
                 )
-            birds_eye_png(r, tmp / f"{r.name}.birdseye.png")
         md = [
             f"# rgbd-eval run: {config.method}",
             "",
@@ -413,4 +380,6 @@ def write_run(
         (tmp / "report.json").write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
+        if also is not None:
+            also(tmp, report)
     return report

@@ -9,7 +9,7 @@ One sequence is a pair (tracker output, ground truth), read by
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -143,9 +143,16 @@ def table_rows(sequences: Sequence[ScoredSequence], gating: Gating) -> list[list
 
 
 def write_report(
-    out_dir: Path, sequences: Sequence[ScoredSequence], config: EvaluationConfig, max_gap_ns: int
+    out_dir: Path,
+    sequences: Sequence[ScoredSequence],
+    config: EvaluationConfig,
+    max_gap_ns: int,
+    also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write report.json, report.md and one events.csv per sequence, atomically as a folder."""
+    """Write report.json, report.md and one events.csv per sequence, atomically as a folder.
+
+    ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder.
+    """
     from rgbd_eval.report import table_header
 
     report = report_dict(sequences, config, max_gap_ns)
@@ -173,4 +180,6 @@ def write_report(
         (tmp / "report.json").write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
+        if also is not None:
+            also(tmp, report)
     return report

@@ -111,6 +111,9 @@ def bench(
         bool,
         typer.Option("--all-cores", help="do not pin to one CPU (OpenCV may use threads)"),
     ] = False,
+    html_file: Annotated[
+        Path | None, typer.Option("--html", help="also write the figures as an HTML page")
+    ] = None,
     topics: TopicOption = None,
 ) -> None:
     """Time each pipeline stage on one recording, against the floor of decoding it alone.
@@ -131,6 +134,11 @@ def bench(
     with progress_bar() as bar:
         task = bar.add_task(f"bench {target.name}", total=None)
         result = benchmark(target, config, repeat, advance_callback(bar, task))
+    if html_file is not None:
+        from rgbd_eval.atomic import write_text
+        from rgbd_eval.report_html import bench_page
+
+        write_text(html_file, bench_page(result, STAGE_LABELS))
     if json_out:
         typer.echo(json.dumps(result.to_json(), indent=2))
     else:

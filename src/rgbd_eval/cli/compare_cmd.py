@@ -24,6 +24,9 @@ def compare(
         Path | None, typer.Option("--markdown", help="also write the table as Markdown")
     ] = None,
     all_rows: Annotated[bool, typer.Option("--all", help="show unchanged metrics too")] = False,
+    html_file: Annotated[
+        Path | None, typer.Option("--html", help="also write the deltas as an HTML page")
+    ] = None,
 ) -> None:
     """Per sequence and overall, what got better and what got worse; exit 1 on regression."""
     from rgbd_eval.compare import (  # heavy (report -> metrics -> motmetrics/pandas): only here
@@ -55,6 +58,10 @@ def compare(
         console.print(f"config: {change}")
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison))
+    if html_file is not None:
+        from rgbd_eval.report_html import compare_page
+
+        write_text(html_file, compare_page(comparison, str(baseline), str(current)))
     if comparison.regressions:
         names = ", ".join(f"{d.sequence}/{d.metric}" for d in comparison.regressions)
         console.print(

@@ -45,6 +45,7 @@ def reproduce(
     spec = paper_spec(system)  # ConfigError listing the known papers
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.engine import connect, parse_cluster
+    from rgbd_eval.report_html import reproduce_page
     from rgbd_eval.sim import ensure_scenario
 
     recordings = {
@@ -59,8 +60,12 @@ def reproduce(
         result = spec.run(recordings, options)
     write_text(out_dir / "reproduce.md", result.markdown)
     write_json(out_dir / "reproduce.json", {"method": system, **result.data})
+    write_text(out_dir / "reproduce.html", reproduce_page(result, system))
     console.print(result.markdown, markup=False)
     held = sum(ok for _, ok in result.claims)
     if result.claims:
         console.print(f"claims held: {held} of {len(result.claims)}")
-    console.print(f"written: {out_dir / 'reproduce.md'}, {out_dir / 'reproduce.json'}")
+    console.print(
+        f"written: {out_dir / 'reproduce.md'}, {out_dir / 'reproduce.json'}, "
+        f"{out_dir / 'reproduce.html'}"
+    )

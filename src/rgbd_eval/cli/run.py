@@ -119,6 +119,10 @@ def run(
     json_out: Annotated[
         bool, typer.Option("--json", help="print report.json on stdout instead of a table")
     ] = False,
+    video: Annotated[
+        bool,
+        typer.Option("--video", help="also write <name>.overlay.mp4: tracks on the RGB frames"),
+    ] = False,
     topics: TopicOption = None,
     cluster: Annotated[
         str | None,
@@ -128,6 +132,7 @@ def run(
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
     from rgbd_eval.report import write_run
+    from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:
@@ -161,11 +166,21 @@ def run(
         with connect(spec) as client, progress_bar() as bar:
             task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
             results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
-    report = write_run(out_dir, results, config)
+    with progress_bar() as bar:
+        task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
+        report = write_run(
+            out_dir,
+            results,
+            config,
+            lambda folder, rep: write_run_html(
+                folder, results, config, rep, video, advance_callback(bar, task)
+            ),
+        )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:
         print_table(results, config)
         console.print(
-            f"report: {out_dir / 'report.md'} (machine-readable: {out_dir / 'report.json'})"
+            f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
+            f"(machine-readable: {out_dir / 'report.json'})"
         )

@@ -59,6 +59,7 @@ def score(
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
+    from rgbd_eval.report_html import write_score_html
     from rgbd_eval.scoring import score_sequence, table_rows, write_report
 
     sets = list(overrides or [])
@@ -85,7 +86,13 @@ def score(
         with connect(spec) as client:
             sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"
-    report = write_report(out_dir, sequences, config.evaluation, max_gap_ns)
+    report = write_report(
+        out_dir,
+        sequences,
+        config.evaluation,
+        max_gap_ns,
+        lambda folder, rep: write_score_html(folder, sequences, rep, config.evaluation.gating),
+    )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
         return
@@ -105,4 +112,7 @@ def score(
     for s in sequences:
         for w in s.warnings:
             console.print(f"{s.name}: warning: {w}")
-    console.print(f"report: {out_dir / 'report.md'} (machine-readable: {out_dir / 'report.json'})")
+    console.print(
+        f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
+        f"(machine-readable: {out_dir / 'report.json'})"
+    )

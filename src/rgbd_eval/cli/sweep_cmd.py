@@ -31,41 +31,6 @@ from rgbd_eval.errors import ConfigError, TaskError
 if TYPE_CHECKING:
     from rgbd_eval.sweep import SweepResult
 
-_PLOTTED = (("mota", "MOTA"), ("fp_rate", "FP"), ("fn_rate", "FN"))
-
-
-def sweep_plot(result: SweepResult, path: Path) -> None:
-    """MOTA, FP, FN (%) and ID switches against the swept value (seed 000, Figure 7.10)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    key = result.params[0]
-    pts = result.overall()
-    xs = [float(p[key]) for p, _ in pts]
-    from rgbd_eval.metrics import summarize
-
-    sums = [summarize(c) for _, c in pts]
-    fig, ax = plt.subplots(figsize=(7, 4.5), dpi=100)
-    for metric, label in _PLOTTED:
-        ax.plot(xs, [100 * float(s[metric] or 0.0) for s in sums], "o-", label=f"{label} (%)")
-    ax.set_xlabel(key)
-    ax.set_ylabel("%")
-    ax2 = ax.twinx()
-    ax2.plot(
-        xs, [int(s["id_switches"] or 0) for s in sums], "s--", color="tab:red", label="ID switches"
-    )
-    ax2.set_ylabel("ID switches")
-    lines = ax.get_legend_handles_labels()
-    lines2 = ax2.get_legend_handles_labels()
-    ax.legend(lines[0] + lines2[0], lines[1] + lines2[1], loc="center right", fontsize=8)
-    ax.grid(True, alpha=0.3)
-    ax.set_title("sweep (all sequences summed)")
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-
 
 def _csv(rows: list[dict[str, Any]]) -> str:
     if not rows:
@@ -126,6 +91,7 @@ def sweep(
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
+    from rgbd_eval.report_html import write_sweep_html
     from rgbd_eval.sweep import (
         SweepParam,
         expand_grid,
@@ -216,9 +182,8 @@ def sweep(
             },
         },
     )
-    if len(result.params) == 1 and result.records:
-        sweep_plot(result, out_dir / "sweep.png")
     g = configs[0].evaluation.gating if configs else Gating.IOU
+    write_sweep_html(out_dir, result, method, [str(p) for p in recordings], fixed, g)
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:
@@ -242,7 +207,8 @@ def sweep(
     console.print(
         f"wall {wall:.1f} s (task seconds: detect {result.detect_seconds:.1f}, "
         f"track+score {result.track_seconds:.1f}); detection cache: {result.cache_hits} hit(s), "
-        f"{result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}"
+        f"{result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}, "
+        f"page: {out_dir / 'sweep.html'}"
     )
     if result.failures:
         raise _failed(result, f"; all are listed in {out_dir / 'sweep.json'}")
