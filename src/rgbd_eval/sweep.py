@@ -144,12 +144,13 @@ class SweepResult:
     params: tuple[str, ...]
     grid: tuple[Point, ...]
     records: tuple[SweepRecord, ...]
-    failures: tuple[SweepFailure, ...]
     #: Task seconds summed over prepare (detect or load) and track+score tasks.
     detect_seconds: float
     track_seconds: float
     cache_hits: int
     cache_misses: int
+    #: The (grid point, sequence) tasks that failed, in grid order.
+    failures: tuple[SweepFailure, ...] = ()
     #: Cache entries rejected (checksum, layout) and recomputed, one line each.
     warnings: tuple[str, ...] = ()
 
