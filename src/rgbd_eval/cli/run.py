@@ -22,6 +22,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.errors import InputError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.pipeline import SequenceResult
@@ -123,6 +124,10 @@ def run(
         bool,
         typer.Option("--video", help="also write <name>.overlay.mp4: tracks on the RGB frames"),
     ] = False,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
     cluster: Annotated[
         str | None,
@@ -131,7 +136,7 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
-    from rgbd_eval.report import write_run
+    from rgbd_eval.report import REPORT_FILE, write_run
     from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
@@ -150,32 +155,34 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    if cluster is None and len(recordings) == 1:
-        with progress_bar() as bar:  # one recording: a bar over its frames
-            task = bar.add_task(recordings[0].name, total=None)
-            results.append(run_sequence(recordings[0], config, gt, advance_callback(bar, task)))
-    else:  # a task per recording on the cluster; results come back, this process writes
-        from rgbd_eval.engine import connect, map_ordered, parse_cluster
+    with OutputFolder(out_dir, REPORT_FILE, force) as folder:
+        # The output folder is checked and staged before this work.
+        if cluster is None and len(recordings) == 1:
+            with progress_bar() as bar:  # one recording: a bar over its frames
+                task = bar.add_task(recordings[0].name, total=None)
+                results.append(run_sequence(recordings[0], config, gt, advance_callback(bar, task)))
+        else:  # a task per recording on the cluster; results come back, this process writes
+            from rgbd_eval.engine import connect, map_ordered, parse_cluster
 
-        spec = parse_cluster(cluster, tasks=len(recordings))
-        remote = spec.address is not None  # remote workers do not share our working directory
-        args = [
-            (p.resolve() if remote else p, config, gt.resolve() if gt and remote else gt)
-            for p in recordings
-        ]
-        with connect(spec) as client, progress_bar() as bar:
-            task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
-            results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
-    with progress_bar() as bar:
-        task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
-        report = write_run(
-            out_dir,
-            results,
-            config,
-            lambda folder, rep: write_run_html(
-                folder, results, config, rep, video, advance_callback(bar, task)
-            ),
-        )
+            spec = parse_cluster(cluster, tasks=len(recordings))
+            remote = spec.address is not None  # remote workers do not share our working dir
+            args = [
+                (p.resolve() if remote else p, config, gt.resolve() if gt and remote else gt)
+                for p in recordings
+            ]
+            with connect(spec) as client, progress_bar() as bar:
+                task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
+                results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
+        with progress_bar() as bar:
+            task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
+            report = write_run(
+                folder,
+                results,
+                config,
+                lambda staging, rep: write_run_html(
+                    staging, results, config, rep, video, advance_callback(bar, task)
+                ),
+            )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:

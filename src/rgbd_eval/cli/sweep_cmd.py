@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -27,6 +28,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError, TaskError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.sweep import SweepResult
@@ -40,6 +42,52 @@ def _csv(rows: list[dict[str, Any]]) -> str:
     writer.writeheader()
     writer.writerows(rows)
     return buf.getvalue()
+
+
+def _write_outputs(
+    folder: OutputFolder,
+    result: SweepResult,
+    wall: float,
+    method: str,
+    recordings: list[Path],
+    fixed: list[str],
+    gating: Gating,
+    cluster: str,
+) -> None:
+    """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
+    folder, then publish."""
+    from rgbd_eval.report_html import write_sweep_html
+
+    tmp = folder.staging
+    rows = result.rows()
+    (tmp / "sweep.csv").write_text(_csv(rows), encoding="utf-8")
+    write_sweep_html(tmp, result, method, [str(p) for p in recordings], fixed, gating)
+    record = {
+        "schema_version": SCHEMA_VERSION,
+        "params": list(result.params),
+        "method": method,
+        "datasets": [str(p) for p in recordings],
+        "fixed": fixed,
+        "records": rows,
+        "failures": [
+            {**f.point, "sequence": f.sequence, "error": f.error, "exit_code": f.exit_code}
+            for f in result.failures
+        ],
+        "cluster": cluster,
+        "seconds": {
+            "wall": wall,
+            "detect_tasks": result.detect_seconds,
+            "track_score_tasks": result.track_seconds,
+        },
+        "cache": {
+            "hits": result.cache_hits,
+            "misses": result.cache_misses,
+            "rejected": list(result.warnings),
+        },
+    }
+    text = json.dumps(record, indent=2, allow_nan=False) + "\n"
+    (tmp / "sweep.json").write_text(text, encoding="utf-8")
+    folder.commit()
 
 
 def _failed(result: SweepResult, where: str) -> TaskError:
@@ -81,17 +129,19 @@ def sweep(
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
     cache_mode: Annotated[str, typer.Option(help=CACHE_MODE_HELP)] = "shared",
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
-    from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.cache import DetectionCache
     from rgbd_eval.config import load_config
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
-    from rgbd_eval.report_html import write_sweep_html
     from rgbd_eval.sweep import (
         SweepParam,
         expand_grid,
@@ -136,54 +186,27 @@ def sweep(
     DetectionCache(cache)  # refuses a cache path that is a file before a cluster starts
     spec = parse_cluster(cluster_of(cluster, jobs), tasks=len(grid) * len(recordings))
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
-    start = time.perf_counter()
-    with connect(spec) as client, progress_bar() as bar:
-        tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
-        result = run_sweep(
-            recordings,
-            grid,
-            configs,
-            client,
-            cache_root=cache,
-            cache_mode=mode,
-            progress=lambda stage, done, n: bar.update(tasks[stage], completed=done, total=n),
-        )
-    wall = time.perf_counter() - start
-    for warning in result.warnings:
-        err_console.print(f"warning: {warning}", markup=False, highlight=False)
-    if not result.records:  # nothing scored: no output folder, one error line
-        raise _failed(result, "")
-    rows = result.rows()
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_text(out_dir / "sweep.csv", _csv(rows))
-    write_json(
-        out_dir / "sweep.json",
-        {
-            "schema_version": SCHEMA_VERSION,
-            "params": list(result.params),
-            "method": method,
-            "datasets": [str(p) for p in recordings],
-            "fixed": fixed,
-            "records": rows,
-            "failures": [
-                {**f.point, "sequence": f.sequence, "error": f.error, "exit_code": f.exit_code}
-                for f in result.failures
-            ],
-            "cluster": spec.describe(),
-            "seconds": {
-                "wall": wall,
-                "detect_tasks": result.detect_seconds,
-                "track_score_tasks": result.track_seconds,
-            },
-            "cache": {
-                "hits": result.cache_hits,
-                "misses": result.cache_misses,
-                "rejected": list(result.warnings),
-            },
-        },
-    )
     g = configs[0].evaluation.gating if configs else Gating.IOU
-    write_sweep_html(out_dir, result, method, [str(p) for p in recordings], fixed, g)
+    folder = OutputFolder(out_dir, "sweep.json", force)
+    with folder:  # checked and staged before the sweep; published whole or not at all
+        start = time.perf_counter()
+        with connect(spec) as client, progress_bar() as bar:
+            tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
+            result = run_sweep(
+                recordings,
+                grid,
+                configs,
+                client,
+                cache_root=cache,
+                cache_mode=mode,
+                progress=lambda stage, done, n: bar.update(tasks[stage], completed=done, total=n),
+            )
+        wall = time.perf_counter() - start
+        for warning in result.warnings:
+            err_console.print(f"warning: {warning}", markup=False, highlight=False)
+        if not result.records:  # nothing scored: no output folder, one error line
+            raise _failed(result, "")
+        _write_outputs(folder, result, wall, method, recordings, fixed, g, spec.describe())
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:
