@@ -69,7 +69,7 @@ def test_outside_method_runs_through_every_command(toy_recording: Path, tmp_path
 
     sweep = _cli(
         "sweep", "tracker.gate_m", "0.25", "1.0", "--method", "toy",
-        "--dataset", str(toy_recording), "--jobs", "1", "--out", "sw", cwd=tmp_path,
+        "--dataset", str(toy_recording), "--cluster", "local:1", "--out", "sw", cwd=tmp_path,
     )  # fmt: skip
     assert sweep.returncode == 0, sweep.stderr
     rows = json.loads((tmp_path / "sw" / "sweep.json").read_text())["records"]
@@ -81,7 +81,7 @@ def test_outside_method_runs_through_every_command(toy_recording: Path, tmp_path
     stages = list(json.loads(bench.stdout)["stage_ms"])
     assert stages[:4] == ["index", "decode", "segment", "blobs"], stages
 
-    rep = _cli("reproduce", "toy", "--data", str(toy_recording.parent), "--jobs", "1",
+    rep = _cli("reproduce", "toy", "--data", str(toy_recording.parent), "--cluster", "local:1",
                "--out", "rep", cwd=tmp_path)  # fmt: skip
     assert rep.returncode == 0, rep.stderr
     data = json.loads((tmp_path / "rep" / "reproduce.json").read_text())

@@ -69,7 +69,7 @@ def test_sweep_points_equal_separate_runs(tmp_path: Path) -> None:
     base = load_config(method="basso2012").model_dump(mode="json")
     grid = expand_grid([SweepParam("tracker.min_confidence", (-1.0, 0.5))])
     configs = point_configs(base, [], grid)
-    result = run_sweep([rec], grid, configs, cache_root=tmp_path / "cache", jobs=2)
+    result = run_sweep([rec], grid, configs, cache_root=tmp_path / "cache")
     for record, config in zip(result.records, configs, strict=True):
         single = run_sequence(rec, config)
         assert single.scores is not None
@@ -87,6 +87,7 @@ def test_cli_takes_negative_values_as_values(tmp_path: Path) -> None:
     rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=4))
     args = ["sweep", "tracker.min_confidence", "-3", "-2.5", "0.5", "--dataset", str(rec)]
     args += ["--cache", str(tmp_path / "cache"), "--out", str(tmp_path / "out")]
+    args += ["--cluster", "local:1"]
     result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
@@ -110,3 +111,37 @@ def test_cli_sweeps_a_null_value(tmp_path: Path) -> None:
     records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
     assert [r["tracker.static_devalidation_s"] for r in records] == [None, 2.0]
     assert (tmp_path / "out" / "sweep.png").stat().st_size > 0
+
+
+def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: Path) -> None:
+    from typer.testing import CliRunner
+
+    from rgbd_eval.cli.main import app
+
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=2))
+    (tmp_path / "cache").write_text("a file")
+    args = [
+        "sweep",
+        "tracker.min_confidence",
+        "0",
+        "--dataset",
+        str(rec),
+        "--out",
+        str(tmp_path / "o"),
+    ]
+    result = CliRunner().invoke(app, [*args, "--cache", str(tmp_path / "cache")])
+    assert result.exit_code == 7
+    assert result.output.strip().splitlines() == [
+        f"error: {tmp_path / 'cache'}: is a file, not a detection cache folder"
+    ]
+    result = CliRunner().invoke(app, [*args, "--cluster", "local:0"])
+    assert (result.exit_code, result.output.strip()) == (
+        4,
+        "error: --cluster 'local:0': N in local:N must be at least 1",
+    )
+    # The hidden --jobs N of old scripts is --cluster local:N; not both.
+    result = CliRunner().invoke(app, [*args, "--jobs", "2", "--cluster", "tcp://h:1"])
+    assert result.exit_code == 4 and "--jobs and --cluster: give one" in result.output
+    result = CliRunner().invoke(app, [*args, "--cache-mode", "nfs"])
+    assert result.exit_code == 4 and "expected shared or client" in result.output
+    assert not (tmp_path / "o").exists()

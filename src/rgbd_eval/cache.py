@@ -1,24 +1,49 @@
-"""On-disk cache of detections, keyed by recording content and detector config.
+"""Content-addressed on-disk cache of detections, safe to share between processes and machines.
 
 Detections are a pure function of (recording, io config, detector config: its
-``name`` included), so a sweep over tracker parameters runs detection once per sequence.
-Entries are pickles written atomically; a corrupt or foreign entry is a miss.
+``name`` included), so a sweep over tracker parameters runs detection once per
+sequence. The key is the sha256 of exactly those inputs (:func:`detection_key`).
+
+An entry is one file, ``detections/<key[:2]>/<key>.det``: a magic line, the
+sha256 of the payload in hex, a newline, then the payload, an uncompressed
+``.npz`` of flat arrays (no pickle, ``allow_pickle=False`` on read) whose
+``meta`` member is UTF-8 JSON. Entries are written to a unique temporary file
+beside the target and renamed into place, so concurrent writers of the same key
+(two workers, two machines on a network filesystem) leave one complete entry.
+An entry whose checksum, layout or key does not match is a miss: it is
+recomputed and overwritten, with a warning; it is never trusted.
 """
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
+import io
 import json
 import os
-import pickle
+import uuid
+import warnings
+import zipfile
 from pathlib import Path
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
 
 from rgbd_eval import __version__
 from rgbd_eval.config import RunConfig
+from rgbd_eval.errors import CacheError
 from rgbd_eval.pipeline import SequenceDetections
+from rgbd_eval.types import Box2D, Box3D, Detection
 
 #: Bump when the Detection layout or the detector's behaviour changes incompatibly.
-CACHE_FORMAT = 2
+CACHE_FORMAT = 3  # 3: checksummed npz entries (1 and 2 were pickles)
+_MAGIC = b"rgbd-eval detections 2\n"
+_DIGEST_LEN = 64  # hex sha256
+
+
+class CacheWarning(UserWarning):
+    """A cache entry was unreadable or did not match its checksum, and is recomputed."""
 
 
 def default_cache_dir() -> Path:
@@ -26,47 +51,195 @@ def default_cache_dir() -> Path:
     return Path(os.environ.get("RGBD_EVAL_CACHE", ".cache/rgbd-eval"))
 
 
-def detection_key(recording_digest: str, config: RunConfig) -> str:
-    """The cache key: what the detections depend on, and nothing else."""
+def detector_inputs(config: RunConfig) -> str:
+    """What detections depend on besides the recording, as canonical JSON."""
     payload = {
         "format": CACHE_FORMAT,
         "tool": __version__,
-        "recording": recording_digest,
         "io": config.io.model_dump(mode="json"),
         "detector": config.detector.model_dump(mode="json"),
     }
+    return json.dumps(payload, sort_keys=True)
+
+
+def detection_key(recording_digest: str, config: RunConfig) -> str:
+    """The cache key: what the detections depend on, and nothing else."""
+    payload = {**json.loads(detector_inputs(config)), "recording": recording_digest}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()
 
 
+class _CorruptEntryError(Exception):
+    """Internal: why an entry was rejected (becomes a warning and a miss)."""
+
+
+def encode(key: str, value: SequenceDetections) -> bytes:
+    """The entry file's bytes: magic, sha256 of the payload, payload (see the module docstring)."""
+    dets = [d for frame in value.detections for d in frame]
+    n = len(dets)
+    apps = [None if d.appearance is None else np.asarray(d.appearance) for d in dets]
+    ndim = max([1, *(a.ndim for a in apps if a is not None)])
+    shapes = np.full((n, ndim), -1, dtype=np.int64)
+    for i, a in enumerate(apps):
+        if a is not None:
+            shapes[i, : a.ndim] = a.shape
+    flat = [a.astype(np.float32).ravel() for a in apps if a is not None]
+    arrays: dict[str, NDArray[Any]] = {
+        "stamps_ns": np.asarray(value.stamps_ns, dtype=np.int64),
+        "per_frame": np.asarray([len(f) for f in value.detections], dtype=np.int64),
+        "position": np.asarray([d.position for d in dets], dtype=np.float64).reshape(n, 3),
+        "scalars": np.asarray(
+            [(d.height, d.confidence, d.distance) for d in dets], dtype=np.float64
+        ).reshape(n, 3),
+        "box2d": np.asarray([d.box2d.as_tuple() for d in dets], dtype=np.float64).reshape(n, 4),
+        "box3d": np.asarray(
+            [
+                (*d.box3d.min_corner, *d.box3d.max_corner) if d.box3d else (np.nan,) * 6
+                for d in dets
+            ],
+            dtype=np.float64,
+        ).reshape(n, 6),
+        "flags": np.asarray(
+            [(d.box3d is not None, d.occluded) for d in dets], dtype=np.bool_
+        ).reshape(n, 2),
+        "appearance_shape": shapes,
+        "appearance": np.concatenate(flat) if flat else np.zeros(0, dtype=np.float32),
+        "meta": np.frombuffer(
+            json.dumps({"key": key, "seconds": value.seconds}, sort_keys=True).encode(),
+            dtype=np.uint8,
+        ),
+    }
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)  # type: ignore[arg-type]  # numpy's stub types **kwds too narrowly
+    payload = buf.getvalue()
+    return _MAGIC + hashlib.sha256(payload).hexdigest().encode() + b"\n" + payload
+
+
+def decode(key: str, blob: bytes) -> SequenceDetections:
+    """Inverse of :func:`encode`; raises ``_CorruptEntryError`` on any mismatch."""
+    head = len(_MAGIC) + _DIGEST_LEN + 1
+    if len(blob) < head or not blob.startswith(_MAGIC) or blob[head - 1 : head] != b"\n":
+        raise _CorruptEntryError("not a detection cache entry of this format")
+    payload = blob[head:]
+    if hashlib.sha256(payload).hexdigest().encode() != blob[len(_MAGIC) : head - 1]:
+        raise _CorruptEntryError("checksum mismatch")
+    try:
+        with np.load(io.BytesIO(payload), allow_pickle=False) as npz:
+            a = {name: npz[name] for name in npz.files}
+        meta = json.loads(a["meta"].tobytes().decode("utf-8"))
+    except (OSError, ValueError, KeyError, zipfile.BadZipFile, UnicodeDecodeError) as err:
+        raise _CorruptEntryError(f"unreadable payload ({type(err).__name__})") from err
+    if not isinstance(meta, dict) or meta.get("key") != key:
+        raise _CorruptEntryError("entry belongs to another key")
+    return _unpack(a, meta)
+
+
+def _unpack(a: dict[str, NDArray[Any]], meta: dict[str, Any]) -> SequenceDetections:
+    per_frame = a["per_frame"]
+    n = int(per_frame.sum()) if per_frame.size else 0
+    shapes = a["appearance_shape"]
+    sizes = [int(np.prod(s[s >= 0])) if s[0] >= 0 else 0 for s in shapes]
+    expected = {
+        "position": (n, 3),
+        "scalars": (n, 3),
+        "box2d": (n, 4),
+        "box3d": (n, 6),
+        "flags": (n, 2),
+        "appearance": (sum(sizes),),
+    }
+    if (
+        per_frame.shape != a["stamps_ns"].shape
+        or (per_frame < 0).any()
+        or shapes.ndim != 2
+        or shapes.shape[0] != n
+        or any(a[k].shape != shape for k, shape in expected.items())
+        or not isinstance(meta.get("seconds"), dict)
+    ):
+        raise _CorruptEntryError("inconsistent array shapes")
+    position, scalars, box2d = a["position"].tolist(), a["scalars"].tolist(), a["box2d"].tolist()
+    box3d, flags, app = a["box3d"].tolist(), a["flags"].tolist(), a["appearance"]
+    dets: list[Detection] = []
+    offset = 0
+    for i in range(n):
+        shape = tuple(int(x) for x in shapes[i] if x >= 0)
+        appearance = None
+        if shapes[i][0] >= 0:
+            appearance = app[offset : offset + sizes[i]].reshape(shape).copy()
+            offset += sizes[i]
+        height, confidence, distance = scalars[i]
+        has_box3d, occluded = flags[i]
+        dets.append(
+            Detection(
+                position=_xyz(position[i]),
+                height=height,
+                confidence=confidence,
+                box2d=Box2D(*box2d[i]),
+                box3d=Box3D(_xyz(box3d[i][:3]), _xyz(box3d[i][3:])) if has_box3d else None,
+                distance=distance,
+                occluded=bool(occluded),
+                appearance=appearance,
+            )
+        )
+    frames, start = [], 0
+    for count in per_frame.tolist():
+        frames.append(tuple(dets[start : start + count]))
+        start += count
+    return SequenceDetections(
+        stamps_ns=tuple(a["stamps_ns"].tolist()),
+        detections=tuple(frames),
+        seconds={str(k): float(v) for k, v in meta["seconds"].items()},
+    )
+
+
+def _xyz(values: list[float]) -> tuple[float, float, float]:
+    return (values[0], values[1], values[2])
+
+
 class DetectionCache:
-    """Load and store :class:`SequenceDetections` by key."""
+    """Load and store :class:`SequenceDetections` by key under ``root``."""
 
     def __init__(self, root: Path | None = None) -> None:
         self.root = Path(root) if root is not None else default_cache_dir()
-        self.hits = 0
-        self.misses = 0
+        if self.root.exists() and not self.root.is_dir():
+            raise CacheError(self.root, "is a file, not a detection cache folder")
 
-    def _path(self, key: str) -> Path:
-        return self.root / "detections" / f"{key}.pkl"
+    def path(self, key: str) -> Path:
+        """Where the entry of ``key`` lives."""
+        return self.root / "detections" / key[:2] / f"{key}.det"
 
     def load(self, key: str) -> SequenceDetections | None:
-        path = self._path(key)
+        """The entry of ``key``; None when absent or rejected (a rejection warns)."""
+        path = self.path(key)
         try:
-            with path.open("rb") as handle:
-                value = pickle.load(handle)
-        except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError):
-            self.misses += 1
+            blob = path.read_bytes()
+        except FileNotFoundError:
             return None
-        if not isinstance(value, SequenceDetections):
-            self.misses += 1
+        except OSError as err:
+            warnings.warn(
+                f"detection cache entry {path}: unreadable ({err.strerror}), recomputing",
+                CacheWarning,
+                stacklevel=2,
+            )
             return None
-        self.hits += 1
-        return value
+        try:
+            return decode(key, blob)
+        except _CorruptEntryError as bad:
+            warnings.warn(
+                f"detection cache entry {path}: {bad}, recomputing", CacheWarning, stacklevel=2
+            )
+            return None
 
     def store(self, key: str, detections: SequenceDetections) -> None:
-        path = self._path(key)
-        path.parent.mkdir(parents=True, exist_ok=True)
-        tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-        with tmp.open("wb") as handle:
-            pickle.dump(detections, handle, protocol=pickle.HIGHEST_PROTOCOL)
-        os.replace(tmp, path)
+        """Write the entry of ``key`` atomically (unique temporary file, then rename)."""
+        path = self.path(key)
+        tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
+        blob = encode(key, detections)
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp.write_bytes(blob)
+            os.replace(tmp, path)
+        except OSError as err:
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+            raise CacheError(
+                path, f"cannot write this detection cache entry ({err.strerror or err})"
+            ) from err

@@ -15,19 +15,33 @@ Exit codes (also in README.md):
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
 7     an output cannot be written (not a folder, not writable, someone else's folder,
-      no MP4 encoder for ``--video``)
+      no MP4 encoder for ``--video``, a detection cache folder that is a file)
+8     the Dask cluster cannot be reached, or a task killed every worker it ran on
 ====  =====================================================================
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 
 class RgbdEvalError(Exception):
     """Base class. ``exit_code`` is what the CLI exits with."""
 
     exit_code: int = 1
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # Errors raised on a cluster worker are pickled back to the client; the subclasses'
+        # own __init__ signatures would break the default (cls(*args)) reconstruction.
+        return (_rebuild, (type(self), str(self), dict(self.__dict__)))
+
+
+def _rebuild(cls: type[RgbdEvalError], message: str, state: dict[str, Any]) -> RgbdEvalError:
+    err = cls.__new__(cls)
+    Exception.__init__(err, message)
+    err.__dict__.update(state)
+    return err
 
 
 class InputError(RgbdEvalError):
@@ -94,3 +108,21 @@ class OutputError(RgbdEvalError):
     def __init__(self, path: Path | str, message: str) -> None:
         self.path = Path(path)
         super().__init__(f"{self.path}: {message}")
+
+
+class ClusterError(RgbdEvalError):
+    """The Dask scheduler cannot be reached, or a task lost every worker that ran it."""
+
+    exit_code = 8
+
+
+class TaskError(RgbdEvalError):
+    """Tasks of a sweep failed; the exit code is that of the first failure in grid order."""
+
+    def __init__(self, message: str, exit_code: int) -> None:
+        super().__init__(message)
+        self.exit_code = exit_code
+
+
+class CacheError(OutputError):
+    """The detection cache folder cannot be used (a file, not writable)."""

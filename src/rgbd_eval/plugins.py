@@ -35,6 +35,8 @@ from typing import TYPE_CHECKING, Any
 from rgbd_eval.errors import ConfigError
 
 if TYPE_CHECKING:
+    from distributed import Client
+
     from rgbd_eval.config import ComponentConfig
     from rgbd_eval.detect.protocol import Detector
     from rgbd_eval.track.protocol import Tracker
@@ -154,7 +156,8 @@ class PaperSpec:
 class ReproduceOptions:
     """What ``rgbd-eval reproduce`` passes to a paper's experiments."""
 
-    jobs: int = 1
+    #: The Dask client to run sweeps on (None: a local cluster of one in-process worker).
+    client: Client | None = None
     cache: Path | None = None
     progress: Callable[[str], None] = field(default=lambda _m: None)
 

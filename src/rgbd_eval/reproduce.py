@@ -12,13 +12,13 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.config import RunConfig, build_config, config_dir, load_config, load_yaml
 from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
 from rgbd_eval.detect.protocol import create_detector
-from rgbd_eval.errors import ConfigError, InputError
+from rgbd_eval.errors import ConfigError, InputError, TaskError
 from rgbd_eval.methods.basso2012 import CLUTTER, SCENARIOS
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.metrics.gating import iou_matrix
@@ -34,6 +34,9 @@ from rgbd_eval.pipeline import (
 from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 MEMORY_SECONDS = (0.0, 3.0, 30.0)  # Figure 7.7
 VOXEL_SIZES = (0.04, 0.06, 0.08, 0.10, 0.12, 0.15)  # Figure 7.9
@@ -106,7 +109,7 @@ def _sweep(
     param: str,
     values: tuple[Any, ...],
     base: Mapping[str, Any],
-    jobs: int,
+    client: Client | None,
     cache: Path | None,
 ) -> dict[Any, dict[str, Counts]]:
     """Counts per swept value and scenario name."""
@@ -117,7 +120,12 @@ def _sweep(
         raise ConfigError(
             f"reproduce: two scenarios share one recording file name ({sorted(recordings)})"
         )
-    result = run_sweep(list(recordings.values()), grid, configs, jobs=jobs, cache_root=cache)
+    result = run_sweep(list(recordings.values()), grid, configs, client, cache_root=cache)
+    if result.failures:
+        first = result.failures[0]
+        raise TaskError(
+            f"{param}={first.point[param]} on {first.sequence}: {first.error}", first.exit_code
+        )
     out: dict[Any, dict[str, Counts]] = {}
     for r in result.records:
         out.setdefault(r.point[param], {})[names[r.sequence]] = r.counts
@@ -262,7 +270,7 @@ def voxel_timing(
 
 def reproduce_basso2012(
     recordings: Mapping[str, Path],
-    jobs: int = 1,
+    client: Client | None = None,
     cache: Path | None = None,
     progress: Progress | None = None,
 ) -> Reproduction:
@@ -276,7 +284,7 @@ def reproduce_basso2012(
 
     say("Tables 7.2 and 7.3: default parameters on the six sequences")
     t0 = time.perf_counter()
-    default = _sweep(known, "tracker.min_confidence", (-0.5,), base, jobs, cache)[-0.5]
+    default = _sweep(known, "tracker.min_confidence", (-0.5,), base, client, cache)[-0.5]
     run_seconds = time.perf_counter() - t0
     res.tables["7.2"] = {s: _summary(default[s]) for s in SCENARIOS[:3] if s in default}
     res.tables["7.3"] = {s: _summary(default[s]) for s in SCENARIOS[3:] if s in default}
@@ -291,17 +299,17 @@ def reproduce_basso2012(
     obstacles = {k: v for k, v in recordings.items() if k == "moving_obstacles"}
     if obstacles:
         say("Table 7.4: clusters selected by height or by HOG confidence")
-        sel = _sweep(obstacles, "tracker.selection", ("height", "confidence"), base, jobs, cache)
+        sel = _sweep(obstacles, "tracker.selection", ("height", "confidence"), base, client, cache)
         res.tables["7.4"] = {k: _summary(v["moving_obstacles"]) for k, v in sel.items()}
         say("Table 7.5: with and without the classifier")
-        cls = _sweep(obstacles, "tracker.classifier", (True, False), base, jobs, cache)
+        cls = _sweep(obstacles, "tracker.classifier", (True, False), base, client, cache)
         res.tables["7.5"] = {
             str(k).lower(): _summary(v["moving_obstacles"]) for k, v in cls.items()
         }
     if "moving_complex" in recordings:
         say("Table 7.6: track-initialisation confidence from 0.5 to -3")
         complex_only = {"moving_complex": recordings["moving_complex"]}
-        thr = _sweep(complex_only, "tracker.min_confidence", THRESHOLDS, base, jobs, cache)
+        thr = _sweep(complex_only, "tracker.min_confidence", THRESHOLDS, base, client, cache)
         res.tables["7.6"] = {str(k): _summary(v["moving_complex"]) for k, v in thr.items()}
 
     default_cfg = build_config(base, [])
@@ -328,7 +336,7 @@ def reproduce_basso2012(
     if clutter:
         key, values = STATIC_VARIANT
         say(f"Beyond the thesis: clutter sequences with {key} {values}")
-        var = _sweep(clutter, key, values, base, jobs, cache)
+        var = _sweep(clutter, key, values, base, client, cache)
         for value, by_seq in var.items():
             label = "thesis" if value is None else f"static {value:g} s"
             res.clutter[label] = {name: _summary(c) for name, c in by_seq.items()}

@@ -1,31 +1,52 @@
 """Parameter sweeps: expand a grid, detect once per (sequence, detector config), track and score each point.
 
-Work runs in two phases. Phase 1 computes (or loads from the cache) the
-detections of every sequence for every distinct detector config of the grid;
-phase 2 tracks and scores every (sequence, grid point). A tracker that reads
-frames (``needs_frame``) gets them by reading the recording again in phase 2;
-the others replay the cached detections alone. Both phases run in
-``jobs`` processes (inline when ``jobs == 1``). Results are records, never
-parsed from printed text.
+Work runs as two kinds of Dask tasks (:mod:`rgbd_eval.engine`). A *prepare*
+task loads (or computes and stores) the detections of one sequence for one
+distinct detector config of the grid, and aligns the ground truth with them; a
+*track* task tracks and scores one (grid point, sequence) from its prepare
+task's result, which the scheduler hands from worker to worker. Tasks return
+records to the client; workers write nothing but cache entries.
+
+A task that fails on bad input returns its error instead of raising, so the
+other points complete and the failure is reported with its grid point. A
+worker that dies mid-task is replaced and the task re-run elsewhere; a task
+that kills every worker it runs on becomes a failure of its points.
+
+Results do not depend on the number of workers or on completion order: the
+records are assembled in grid order, and tracking always starts from the
+detections as the cache encodes them (a fresh detection is round-tripped
+through :func:`rgbd_eval.cache.encode` first), so a cache hit and a miss
+track the very same numbers. A tracker that reads frames (``needs_frame``) gets
+them by reading the recording again in its track task; the others replay the
+detections alone.
 """
 
 from __future__ import annotations
 
+import enum
 import itertools
-import os
 import time
+import warnings
 from collections.abc import Callable, Iterable, Mapping, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from rgbd_eval.cache import DetectionCache, detection_key
+from rgbd_eval.cache import (
+    CacheWarning,
+    DetectionCache,
+    decode,
+    detection_key,
+    detector_inputs,
+    encode,
+)
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
-from rgbd_eval.errors import ConfigError, ScoringError
+from rgbd_eval.engine import ClusterSpec, connect, killed_worker_message
+from rgbd_eval.errors import ClusterError, ConfigError, InputError, RgbdEvalError, ScoringError
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,
+    SequenceDetections,
     detect_sequence,
     ground_truth_file,
     match_ground_truth,
@@ -36,6 +57,9 @@ from rgbd_eval.pipeline import (
 )
 from rgbd_eval.report import file_digest
 from rgbd_eval.track.protocol import needs_frame
+
+if TYPE_CHECKING:
+    from distributed import Client, Future
 
 Point = dict[str, Any]
 
@@ -84,6 +108,17 @@ def point_configs(
     return configs
 
 
+class CacheMode(enum.Enum):
+    """Who reads and writes the detection cache folder."""
+
+    #: Workers load and store entries themselves: the folder is on a disk every worker sees
+    #: under the same path (local cluster, or a network filesystem).
+    SHARED = "shared"
+    #: Only the client touches the folder: hits are sent to workers with their tasks, fresh
+    #: detections come back to the client, which stores them (workers share no disk).
+    CLIENT = "client"
+
+
 @dataclass(frozen=True)
 class SweepRecord:
     """The scores of one sequence at one grid point."""
@@ -95,17 +130,32 @@ class SweepRecord:
 
 
 @dataclass(frozen=True)
+class SweepFailure:
+    """A (grid point, sequence) that could not be scored, with the one-line error."""
+
+    point: Point
+    sequence: str
+    error: str
+    exit_code: int
+
+
+@dataclass(frozen=True)
 class SweepResult:
     params: tuple[str, ...]
     grid: tuple[Point, ...]
     records: tuple[SweepRecord, ...]
+    #: Task seconds summed over prepare (detect or load) and track+score tasks.
     detect_seconds: float
     track_seconds: float
     cache_hits: int
     cache_misses: int
+    #: The (grid point, sequence) tasks that failed, in grid order.
+    failures: tuple[SweepFailure, ...] = ()
+    #: Cache entries rejected (checksum, layout) and recomputed, one line each.
+    warnings: tuple[str, ...] = ()
 
     def overall(self) -> list[tuple[Point, Counts]]:
-        """Per grid point, the counts summed over sequences."""
+        """Per grid point, the counts summed over sequences (failed ones left out)."""
         out = []
         for point in self.grid:
             counts = [r.counts for r in self.records if r.point == point]
@@ -126,124 +176,219 @@ class SweepResult:
 
 
 @dataclass(frozen=True)
+class _Failed:
+    """A task's error, returned rather than raised so that the other tasks go on."""
+
+    error: str
+    exit_code: int
+
+
+@dataclass(frozen=True)
 class _Prepared:
-    """Phase-1 output for one sequence and one detector config."""
+    """Prepare-task output for one sequence and one detector config."""
 
     path: Path
     key: str
+    detections: SequenceDetections
     ground_truth: GroundTruthMatch
     seconds: float
     hit: bool
+    rejected: tuple[str, ...]
 
 
-def _detect_job(
-    path: Path, digest: str, config: RunConfig, gt_path: Path | None, cache_root: Path
-) -> _Prepared:
+@dataclass(frozen=True)
+class _Brief:
+    """What the client needs of a prepare task (not the detections, unless it stores them)."""
+
+    seconds: float
+    hit: bool
+    rejected: tuple[str, ...]
+    failed: _Failed | None
+
+
+def _prepare(
+    path: Path,
+    digest: str | None,
+    config: RunConfig,
+    gt_path: Path | None,
+    cache_root: Path | None,
+    cached: SequenceDetections | None,
+) -> _Prepared | _Failed:
+    """Detections (cache, ``cached`` from the client, or fresh) and aligned ground truth.
+
+    ``digest`` is the recording's :func:`file_digest`, computed here when None.
+    """
     start = time.perf_counter()
-    cache = DetectionCache(cache_root)
-    key = detection_key(digest, config)
-    gt = ground_truth_file(path, gt_path)
-    detections = cache.load(key)
-    hit = detections is not None
-    if detections is None or gt is None:
-        # The index pass reads every image message: only when detecting or for a ground-truth topic.
-        recording = open_for(path, config)
-        if gt is None:
-            gt = recording.ground_truth_topic
-        if gt is None:
-            raise ScoringError(
-                f"{path}: a sweep needs ground truth (topic, <name>.gt.csv sidecar or --gt)"
-            )
-        if detections is None:
-            detections = detect_sequence(recording, config)
-            cache.store(key, detections)
-    matched = match_ground_truth(gt, detections.stamps_ns, config)
-    return _Prepared(path, key, matched, time.perf_counter() - start, hit)
+    try:
+        try:
+            key = detection_key(digest or file_digest(path), config)
+        except OSError as err:
+            raise InputError(path, f"cannot read ({err.strerror or err})") from err
+        cache = DetectionCache(cache_root) if cache_root is not None else None
+        detections = cached
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", CacheWarning)
+            if detections is None and cache is not None:
+                detections = cache.load(key)
+        rejected = tuple(str(w.message) for w in caught if issubclass(w.category, CacheWarning))
+        hit = detections is not None
+        gt = ground_truth_file(path, gt_path)
+        if detections is None or gt is None:
+            # The index pass reads every image message: only when detecting or for a ground-truth topic.
+            recording = open_for(path, config)
+            if gt is None:
+                gt = recording.ground_truth_topic
+            if gt is None:
+                raise ScoringError(
+                    f"{path}: a sweep needs ground truth (topic, <name>.gt.csv sidecar or --gt)"
+                )
+            if detections is None:
+                # Tracked in its encoded form, so that a later cache hit tracks the same numbers.
+                detections = decode(key, encode(key, detect_sequence(recording, config)))
+                if cache is not None:
+                    cache.store(key, detections)
+        matched = match_ground_truth(gt, detections.stamps_ns, config)
+    except RgbdEvalError as err:
+        return _Failed(" ".join(str(err).split()), err.exit_code)
+    return _Prepared(path, key, detections, matched, time.perf_counter() - start, hit, rejected)
 
 
-def _track_job(prepared: _Prepared, config: RunConfig, cache_root: Path) -> tuple[Counts, float]:
+def _brief(prepared: _Prepared | _Failed) -> _Brief:
+    if isinstance(prepared, _Failed):
+        return _Brief(0.0, False, (), prepared)
+    return _Brief(prepared.seconds, prepared.hit, prepared.rejected, None)
+
+
+def _track(prepared: _Prepared | _Failed, config: RunConfig) -> tuple[Counts, float] | _Failed:
+    """Track and score one grid point on one sequence."""
+    if isinstance(prepared, _Failed):
+        return prepared
     start = time.perf_counter()
-    detections = DetectionCache(cache_root).load(prepared.key)
-    if detections is None:
-        raise ConfigError(f"detection cache entry {prepared.key} vanished during the sweep")
-    # A tracker that reads frames replays them from the recording, read again.
-    recording = open_for(prepared.path, config) if needs_frame(config) else None
-    tracks = track_sequence(detections, config, recording)
-    scores = score_sequence(prepared.ground_truth, tracks, config)
+    try:
+        # A tracker that reads frames replays them from the recording, read again.
+        recording = open_for(prepared.path, config) if needs_frame(config) else None
+        tracks = track_sequence(prepared.detections, config, recording)
+        scores = score_sequence(prepared.ground_truth, tracks, config)
+    except RgbdEvalError as err:
+        return _Failed(" ".join(str(err).split()), err.exit_code)
     return scores.counts, time.perf_counter() - start
+
+
+def _outcome(future: Future[Any]) -> Any:
+    """A task's result; a task that killed every worker it ran on becomes a failure."""
+    from distributed import KilledWorker
+
+    try:
+        return future.result()
+    except KilledWorker as err:
+        return _Failed(killed_worker_message(err), ClusterError.exit_code)
 
 
 def run_sweep(
     recordings: Sequence[Path],
     grid: Sequence[Point],
     configs: Sequence[RunConfig],
-    jobs: int = 1,
+    client: Client | None = None,
     cache_root: Path | None = None,
     gt_path: Path | None = None,
     progress: Callable[[str, int, int], None] | None = None,
+    cache_mode: CacheMode = CacheMode.SHARED,
 ) -> SweepResult:
-    """Run every grid point on every recording (see the module docstring)."""
-    if jobs < 1:
-        raise ConfigError(f"--jobs {jobs}: must be at least 1")
+    """Run every grid point on every recording (see the module docstring).
+
+    Without ``client``, a local cluster of one in-process worker runs the sweep.
+    ``progress(stage, done, total)`` is called as tasks complete, stage
+    ``"detect"`` or ``"track+score"``.
+    """
+    if client is None:
+        with connect(ClusterSpec(None, 1)) as own:
+            return run_sweep(
+                recordings, grid, configs, own, cache_root, gt_path, progress, cache_mode
+            )
+    from distributed import as_completed
+
     cache = DetectionCache(cache_root)
-    root = cache.root
-    digests = {p: file_digest(p) for p in recordings}
-    # Phase 1: one detection pass per (recording, distinct detector config).
-    det_jobs: dict[tuple[Path, str], RunConfig] = {}
-    for config in configs:
-        for path in recordings:
-            det_jobs.setdefault((path, detection_key(digests[path], config)), config)
-    start = time.perf_counter()
-    prepared: dict[tuple[Path, str], _Prepared] = {}
-    items = list(det_jobs.items())
-    args = [(path, digests[path], cfg, gt_path, root) for (path, _), cfg in items]
-    for done, result in enumerate(_map(_detect_job, args, jobs), start=1):
-        prepared[(result.path, result.key)] = result
-        if progress:
-            progress("detect", done, len(items))
-    detect_s = time.perf_counter() - start
-    # Phase 2: track and score each (grid point, recording).
-    start = time.perf_counter()
+    root = cache.root.resolve()  # workers may not share the client's working directory
+    client_side = cache_mode is CacheMode.CLIENT
+    # The client hashes the recordings only when it reads the cache itself; otherwise each
+    # prepare task hashes its recording on a worker, in parallel.
+    digests = {p: file_digest(p) for p in recordings} if client_side else {}
     units = [
         (point, cfg, path) for point, cfg in zip(grid, configs, strict=True) for path in recordings
     ]
-    track_args = [
-        (prepared[(path, detection_key(digests[path], cfg))], cfg, root) for _, cfg, path in units
-    ]
-    records = []
-    for done, ((point, _, path), (counts, seconds)) in enumerate(
-        zip(units, _map(_track_job, track_args, jobs), strict=True), start=1
-    ):
-        records.append(SweepRecord(dict(point), sequence_name(path), counts, seconds))
-        if progress:
-            progress("track+score", done, len(units))
-    track_s = time.perf_counter() - start
-    hits = sum(p.hit for p in prepared.values())
+    # One prepare task per (recording, distinct detector inputs), the track tasks that use it
+    # submitted right after it: the scheduler runs earlier submissions first, so a
+    # recording's detections are tracked, then released, before many more are loaded.
+    groups: dict[tuple[Path, str], list[int]] = {}
+    for i, (_, cfg, path) in enumerate(units):
+        groups.setdefault((path, detector_inputs(cfg)), []).append(i)
+    prepared: dict[tuple[Path, str], Future[Any]] = {}
+    briefs: dict[tuple[Path, str], Future[Any]] = {}
+    tracked: dict[int, Future[Any]] = {}
+    rejected: list[str] = []
+    for group, members in groups.items():
+        path, cfg = group[0], units[members[0]][1]
+        cached = None
+        if client_side:
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", CacheWarning)
+                cached = cache.load(detection_key(digests[path], cfg))
+            rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
+        prep = client.submit(
+            _prepare,
+            path.resolve(),
+            digests.get(path),
+            cfg,
+            gt_path.resolve() if gt_path is not None else None,
+            None if client_side else root,
+            client.scatter(cached) if cached is not None else None,
+            pure=False,
+        )
+        briefs[group] = client.submit(_brief, prep, pure=False)
+        for i in members:
+            tracked[i] = client.submit(_track, prep, units[i][1], pure=False)
+        if client_side:
+            # Kept to fetch fresh detections. Otherwise the client holds no reference, so
+            # the scheduler frees the detections once this group's track tasks are done.
+            prepared[group] = prep
+    stage = {f.key: "detect" for f in briefs.values()}
+    stage |= {f.key: "track+score" for f in tracked.values()}
+    totals = {"detect": len(briefs), "track+score": len(tracked)}
+    done = dict.fromkeys(totals, 0)
+    try:
+        for future in as_completed([*briefs.values(), *tracked.values()], loop=client.loop):
+            name = stage[future.key]
+            done[name] += 1
+            if progress:
+                progress(name, done[name], totals[name])
+        brief = {k: _outcome(f) for k, f in briefs.items()}
+        outcomes = [_outcome(tracked[i]) for i in range(len(units))]
+        if client_side:  # fresh detections come back here to be stored
+            for group, b in brief.items():
+                if isinstance(b, _Brief) and b.failed is None and not b.hit:
+                    fresh = prepared[group].result()
+                    cache.store(fresh.key, fresh.detections)
+    finally:
+        client.cancel([*prepared.values(), *briefs.values(), *tracked.values()])
+    records, failures = [], []
+    for (point, _, path), out in zip(units, outcomes, strict=True):
+        if isinstance(out, _Failed):
+            failures.append(
+                SweepFailure(dict(point), sequence_name(path), out.error, out.exit_code)
+            )
+        else:
+            counts, seconds = out
+            records.append(SweepRecord(dict(point), sequence_name(path), counts, seconds))
+    ok = [b for b in brief.values() if isinstance(b, _Brief) and b.failed is None]
+    hits = sum(b.hit for b in ok)
     return SweepResult(
         params=tuple(grid[0].keys()) if grid else (),
         grid=tuple(dict(p) for p in grid),
         records=tuple(records),
-        detect_seconds=detect_s,
-        track_seconds=track_s,
+        failures=tuple(failures),
+        detect_seconds=sum(b.seconds for b in ok),
+        track_seconds=sum(r.seconds for r in records),
         cache_hits=hits,
-        cache_misses=len(prepared) - hits,
+        cache_misses=len(ok) - hits,
+        warnings=(*rejected, *(w for b in ok for w in b.rejected)),
     )
-
-
-def default_jobs() -> int:
-    """Worker processes when none are asked for: one per CPU this process may use."""
-    if hasattr(os, "sched_getaffinity"):
-        return max(1, len(os.sched_getaffinity(0)))
-    return max(1, os.cpu_count() or 1)
-
-
-def _map(func: Callable[..., Any], args: list[tuple[Any, ...]], jobs: int) -> Iterable[Any]:
-    """``func(*a)`` for each ``a``, in order; in ``jobs`` processes when jobs > 1."""
-    if jobs == 1 or len(args) <= 1:
-        for a in args:
-            yield func(*a)
-        return
-    with ProcessPoolExecutor(max_workers=min(jobs, len(args))) as pool:
-        futures = [pool.submit(func, *a) for a in args]
-        for future in futures:
-            yield future.result()

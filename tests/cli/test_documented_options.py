@@ -16,7 +16,7 @@ from rgbd_eval.cli.main import app
 ROOT = Path(__file__).resolve().parents[2]
 OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
 #: Flags that belong to other programs quoted in the README (pip, pytest, dask).
-FOREIGN = {"--no-deps", "--upgrade", "--strict-markers"}
+FOREIGN = {"--no-deps", "--upgrade", "--strict-markers", "--nworkers", "--nthreads"}
 
 
 def _options() -> dict[str, set[str]]:

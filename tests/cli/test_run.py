@@ -83,7 +83,7 @@ def test_folder_of_recordings_gives_overall_row(tmp_path: Path) -> None:
     write_recording(data / "a.mcap", "mcap", Spec(n=2))
     write_recording(data / "b.bag", "ros1", Spec(n=3))
     out = tmp_path / "out"
-    result = runner.invoke(app, ["run", str(data), "--out", str(out)])
+    result = runner.invoke(app, ["run", str(data), "--out", str(out), "--cluster", "local:1"])
     assert result.exit_code == 0, result.output
     report = json.loads((out / "report.json").read_text())
     assert [s["name"] for s in report["sequences"]] == ["a", "b"]
@@ -98,7 +98,7 @@ def test_topic_option_chooses_streams_on_run_bench_and_sweep(tmp_path: Path) -> 
     for args in (
         ["run", str(rec), "--out", str(tmp_path / "o")],
         ["bench", str(rec), "--repeat", "1", "--all-cores"],
-        ["sweep", "tracker.min_confidence", "0", "--dataset", str(rec), "--jobs", "1"],
+        ["sweep", "tracker.min_confidence", "0", "--dataset", str(rec), "--cluster", "local:1"],
     ):
         result = runner.invoke(app, [*args, "--topic", wrong])
         assert result.exit_code == 3, (args[0], result.output)

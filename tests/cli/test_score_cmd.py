@@ -131,3 +131,15 @@ def test_bad_input_exit_codes(tmp_path: Path) -> None:
         ],
     )
     assert bad.exit_code == 4
+
+
+def test_score_on_a_cluster_gives_the_same_report(tmp_path: Path) -> None:
+    gt, tracks = _write(tmp_path)
+    reports = []
+    for extra in ([], ["--cluster", "local:1"]):
+        out = tmp_path / f"out{len(extra)}"
+        args = ["score", str(tracks), "--gt", str(gt), "--out", str(out), "--json", *extra]
+        result = runner.invoke(app, args)
+        assert result.exit_code == 0, result.output
+        reports.append(json.loads((out / "report.json").read_text())["sequences"])
+    assert reports[0] == reports[1] and reports[0][0]["counts"]["num_matches"] == 2

@@ -151,7 +151,7 @@ def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> Rep
     grid = expand_grid([SweepParam("tracker.gate_m", (0.25, 1.0))])
     configs = point_configs({"method": "toy", "evaluation": {"gating": "metric"}}, [], grid)
     result = run_sweep(
-        list(recordings.values()), grid, configs, jobs=options.jobs, cache_root=options.cache
+        list(recordings.values()), grid, configs, options.client, cache_root=options.cache
     )
     mota = {p["tracker.gate_m"]: summarize(c)["mota"] for p, c in result.overall()}
     held = mota[1.0] is not None and mota[0.25] is not None and mota[1.0] >= mota[0.25]

@@ -7,7 +7,7 @@ import signal
 import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
-from typing import Annotated, Any, ParamSpec, TypeVar
+from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import typer
 from rich.console import Console
@@ -22,6 +22,9 @@ from rich.progress import (
 
 from rgbd_eval.errors import ConfigError, RgbdEvalError
 
+if TYPE_CHECKING:
+    from rgbd_eval.sweep import CacheMode
+
 P = ParamSpec("P")
 R = TypeVar("R")
 
@@ -30,6 +33,37 @@ console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
 err_console = Console(stderr=True, highlight=False)
 
 SCHEMA_VERSION = 1
+
+CLUSTER_HELP = (
+    "where tasks run: local (one worker per usable CPU), local:N, or tcp://scheduler:8786"
+)
+#: ``--jobs N``, the option before Dask, kept hidden for old scripts: ``--cluster local:N``.
+JobsOption = Annotated[int | None, typer.Option(hidden=True, help="same as --cluster local:N")]
+
+
+def cluster_of(cluster: str, jobs: int | None) -> str:
+    """``--cluster``, or ``local:N`` from the hidden ``--jobs N``."""
+    if jobs is None:
+        return cluster
+    if cluster != "local":
+        raise ConfigError("--jobs and --cluster: give one (--jobs N is --cluster local:N)")
+    return f"local:{jobs}"
+
+
+CACHE_MODE_HELP = (
+    "shared: workers use the cache folder (same path everywhere); "
+    "client: only this process does (workers share no disk)"
+)
+
+
+def parse_cache_mode(text: str) -> CacheMode:
+    """``--cache-mode`` value -> CacheMode."""
+    from rgbd_eval.sweep import CacheMode
+
+    try:
+        return CacheMode(text)
+    except ValueError:
+        raise ConfigError(f"--cache-mode {text!r}: expected shared or client") from None
 
 
 def progress_bar() -> Progress:

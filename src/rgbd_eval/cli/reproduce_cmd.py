@@ -8,7 +8,14 @@ from typing import Annotated
 
 import typer
 
-from rgbd_eval.cli.common import console, err_console, handle_errors
+from rgbd_eval.cli.common import (
+    CLUSTER_HELP,
+    JobsOption,
+    cluster_of,
+    console,
+    err_console,
+    handle_errors,
+)
 
 
 @handle_errors
@@ -19,9 +26,8 @@ def reproduce(
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/reproduce-<method>-<time>)")
     ] = None,
-    jobs: Annotated[
-        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
-    ] = None,
+    cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
+    jobs: JobsOption = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
     data: Annotated[
         Path | None,
@@ -38,21 +44,20 @@ def reproduce(
         return
     spec = paper_spec(system)  # ConfigError listing the known papers
     from rgbd_eval.atomic import write_json, write_text
+    from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.report_html import reproduce_page
     from rgbd_eval.sim import ensure_scenario
-    from rgbd_eval.sweep import default_jobs
 
     recordings = {
         Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
         for name in spec.scenarios
     }
     out_dir = out or Path("runs") / f"reproduce-{system}-{time.strftime('%Y%m%d-%H%M%S')}"
-    options = ReproduceOptions(
-        jobs=jobs if jobs is not None else default_jobs(),
-        cache=cache,
-        progress=lambda m: err_console.print(m),
-    )
-    result = spec.run(recordings, options)
+    with connect(parse_cluster(cluster_of(cluster, jobs))) as client:
+        options = ReproduceOptions(
+            client=client, cache=cache, progress=lambda m: err_console.print(m)
+        )
+        result = spec.run(recordings, options)
     write_text(out_dir / "reproduce.md", result.markdown)
     write_json(out_dir / "reproduce.json", {"method": system, **result.data})
     write_text(out_dir / "reproduce.html", reproduce_page(result, system))

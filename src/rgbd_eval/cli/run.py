@@ -11,6 +11,7 @@ import typer
 from rich.table import Table
 
 from rgbd_eval.cli.common import (
+    CLUSTER_HELP,
     TopicOption,
     advance_callback,
     console,
@@ -128,6 +129,10 @@ def run(
         typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
     ] = False,
     topics: TopicOption = None,
+    cluster: Annotated[
+        str | None,
+        typer.Option(help=f"{CLUSTER_HELP} (default: in this process for one recording)"),
+    ] = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
@@ -150,20 +155,34 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with OutputFolder(out_dir, REPORT_FILE, force) as folder, progress_bar() as bar:
-        for path in recordings:  # the output folder is checked and staged before this work
-            task = bar.add_task(path.name, total=None)
-            results.append(run_sequence(path, config, gt, advance_callback(bar, task)))
-            bar.remove_task(task)
-        task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
-        report = write_run(
-            folder,
-            results,
-            config,
-            lambda staging, rep: write_run_html(
-                staging, results, config, rep, video, advance_callback(bar, task)
-            ),
-        )
+    with OutputFolder(out_dir, REPORT_FILE, force) as folder:
+        # The output folder is checked and staged before this work.
+        if cluster is None and len(recordings) == 1:
+            with progress_bar() as bar:  # one recording: a bar over its frames
+                task = bar.add_task(recordings[0].name, total=None)
+                results.append(run_sequence(recordings[0], config, gt, advance_callback(bar, task)))
+        else:  # a task per recording on the cluster; results come back, this process writes
+            from rgbd_eval.engine import connect, map_ordered, parse_cluster
+
+            spec = parse_cluster(cluster, tasks=len(recordings))
+            remote = spec.address is not None  # remote workers do not share our working dir
+            args = [
+                (p.resolve() if remote else p, config, gt.resolve() if gt and remote else gt)
+                for p in recordings
+            ]
+            with connect(spec) as client, progress_bar() as bar:
+                task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
+                results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
+        with progress_bar() as bar:
+            task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
+            report = write_run(
+                folder,
+                results,
+                config,
+                lambda staging, rep: write_run_html(
+                    staging, results, config, rep, video, advance_callback(bar, task)
+                ),
+            )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:

@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import console, handle_errors
+from rgbd_eval.cli.common import CLUSTER_HELP, console, handle_errors
 from rgbd_eval.config import load_config
 from rgbd_eval.errors import ConfigError
 
@@ -53,6 +53,9 @@ def score(
     json_out: Annotated[
         bool, typer.Option("--json", help="print report.json on stdout instead of a table")
     ] = False,
+    cluster: Annotated[
+        str | None, typer.Option(help=f"{CLUSTER_HELP} (default: in this process)")
+    ] = None,
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
@@ -70,12 +73,18 @@ def score(
         known = ", ".join(b.value for b in Benchmark)
         raise ConfigError(f"--benchmark {benchmark!r}: expected one of {known}") from err
     max_gap_ns = int(config.io.max_sync_gap_ms * 1e6)
-    sequences = [
-        score_sequence(
-            name, t, g, config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame
-        )
-        for name, t, g in sequence_pairs(tracks, gt)
-    ]
+    pairs = sequence_pairs(tracks, gt)
+    rest = (config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame)
+    if cluster is None:
+        sequences = [score_sequence(name, t, g, *rest) for name, t, g in pairs]
+    else:  # a task per sequence; results come back, this process writes the report
+        from rgbd_eval.engine import connect, map_ordered, parse_cluster
+
+        spec = parse_cluster(cluster, tasks=len(pairs))
+        if spec.address is not None:  # remote workers do not share our working directory
+            pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
+        with connect(spec) as client:
+            sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"
     report = write_report(
         out_dir,

@@ -13,14 +13,21 @@ import typer
 from rich.table import Table
 
 from rgbd_eval.cli.common import (
+    CACHE_MODE_HELP,
+    CLUSTER_HELP,
     SCHEMA_VERSION,
+    JobsOption,
     TopicOption,
+    cluster_of,
     console,
+    err_console,
     handle_errors,
+    parse_cache_mode,
+    progress_bar,
     topic_overrides,
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.errors import ConfigError, TaskError
 from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
@@ -28,6 +35,8 @@ if TYPE_CHECKING:
 
 
 def _csv(rows: list[dict[str, Any]]) -> str:
+    if not rows:
+        return ""
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=list(rows[0]), lineterminator="\n")
     writer.writeheader()
@@ -43,6 +52,7 @@ def _write_outputs(
     recordings: list[Path],
     fixed: list[str],
     gating: Gating,
+    cluster: str,
 ) -> None:
     """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
     folder, then publish."""
@@ -59,16 +69,37 @@ def _write_outputs(
         "datasets": [str(p) for p in recordings],
         "fixed": fixed,
         "records": rows,
+        "failures": [
+            {**f.point, "sequence": f.sequence, "error": f.error, "exit_code": f.exit_code}
+            for f in result.failures
+        ],
+        "cluster": cluster,
         "seconds": {
             "wall": wall,
-            "detect": result.detect_seconds,
-            "track_score": result.track_seconds,
+            "detect_tasks": result.detect_seconds,
+            "track_score_tasks": result.track_seconds,
         },
-        "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
+        "cache": {
+            "hits": result.cache_hits,
+            "misses": result.cache_misses,
+            "rejected": list(result.warnings),
+        },
     }
     text = json.dumps(record, indent=2, allow_nan=False) + "\n"
     (tmp / "sweep.json").write_text(text, encoding="utf-8")
     folder.commit()
+
+
+def _failed(result: SweepResult, where: str) -> TaskError:
+    """One line: how many (point, sequence) tasks failed, and the first failure in grid order."""
+    first = result.failures[0]
+    label = ", ".join(f"{k}={v}" for k, v in first.point.items())
+    n, units = len(result.failures), len(result.failures) + len(result.records)
+    return TaskError(
+        f"{n} of {units} sweep point(s) failed{where}; first: {label} on {first.sequence}: "
+        f"{first.error}",
+        first.exit_code,
+    )
 
 
 @handle_errors
@@ -91,13 +122,13 @@ def sweep(
         list[str] | None, typer.Option("--set", help="fixed KEY=VALUE override")
     ] = None,
     gating: Annotated[str | None, typer.Option(help="'iou' or 'metric'")] = None,
-    jobs: Annotated[
-        int | None, typer.Option(help="worker processes (default: one per usable CPU)")
-    ] = None,
+    cluster: Annotated[str, typer.Option(help=CLUSTER_HELP)] = "local",
+    jobs: JobsOption = None,
     out: Annotated[
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    cache_mode: Annotated[str, typer.Option(help=CACHE_MODE_HELP)] = "shared",
     force: Annotated[
         bool,
         typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
@@ -106,12 +137,13 @@ def sweep(
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
+    from rgbd_eval.cache import DetectionCache
     from rgbd_eval.config import load_config
+    from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
     from rgbd_eval.sweep import (
         SweepParam,
-        default_jobs,
         expand_grid,
         parse_param,
         point_configs,
@@ -150,15 +182,31 @@ def sweep(
     configs = point_configs(base, parse_overrides(fixed), grid)
     recordings = [datasets.resolve(n) for n in (names or ["demo"])]
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
-    jobs = jobs if jobs is not None else default_jobs()
-    console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
+    mode = parse_cache_mode(cache_mode)
+    DetectionCache(cache)  # refuses a cache path that is a file before a cluster starts
+    spec = parse_cluster(cluster_of(cluster, jobs), tasks=len(grid) * len(recordings))
+    console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
     g = configs[0].evaluation.gating if configs else Gating.IOU
     folder = OutputFolder(out_dir, "sweep.json", force)
     with folder:  # checked and staged before the sweep; published whole or not at all
         start = time.perf_counter()
-        result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
+        with connect(spec) as client, progress_bar() as bar:
+            tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
+            result = run_sweep(
+                recordings,
+                grid,
+                configs,
+                client,
+                cache_root=cache,
+                cache_mode=mode,
+                progress=lambda stage, done, n: bar.update(tasks[stage], completed=done, total=n),
+            )
         wall = time.perf_counter() - start
-        _write_outputs(folder, result, wall, method, recordings, fixed, g)
+        for warning in result.warnings:
+            err_console.print(f"warning: {warning}", markup=False, highlight=False)
+        if not result.records:  # nothing scored: no output folder, one error line
+            raise _failed(result, "")
+        _write_outputs(folder, result, wall, method, recordings, fixed, g, spec.describe())
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:
@@ -180,7 +228,10 @@ def sweep(
         table.add_row(*[str(point[p]) for p in result.params], *cells)
     console.print(table)
     console.print(
-        f"wall {wall:.1f} s (detect {result.detect_seconds:.1f} s, track+score {result.track_seconds:.1f} s); "
-        f"detection cache: {result.cache_hits} hit(s), {result.cache_misses} miss(es); "
-        f"records: {out_dir / 'sweep.csv'}, page: {out_dir / 'sweep.html'}"
+        f"wall {wall:.1f} s (task seconds: detect {result.detect_seconds:.1f}, "
+        f"track+score {result.track_seconds:.1f}); detection cache: {result.cache_hits} hit(s), "
+        f"{result.cache_misses} miss(es); records: {out_dir / 'sweep.csv'}, "
+        f"page: {out_dir / 'sweep.html'}"
     )
+    if result.failures:
+        raise _failed(result, f"; all are listed in {out_dir / 'sweep.json'}")

@@ -44,7 +44,7 @@ def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> Rep
     from rgbd_eval.reproduce import paper_values, render_markdown, reproduce_basso2012, to_json
 
     res = reproduce_basso2012(
-        recordings, jobs=options.jobs, cache=options.cache, progress=options.progress
+        recordings, client=options.client, cache=options.cache, progress=options.progress
     )
     return ReproduceResult(
         markdown=render_markdown(res, paper_values()),

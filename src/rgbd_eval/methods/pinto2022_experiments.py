@@ -134,7 +134,7 @@ def _sweep(
 ) -> list[dict[str, Counts]]:
     """Counts per point (in order) and scenario name."""
     configs = point_configs(base, [], points)
-    result = run_sweep(list(recordings.values()), points, configs, options.jobs, options.cache)
+    result = run_sweep(list(recordings.values()), points, configs, options.client, options.cache)
     names = {sequence_name(p): n for n, p in recordings.items()}
     out: list[dict[str, Counts]] = [{} for _ in points]
     for r in result.records:
