@@ -65,7 +65,7 @@ bench: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
 
 test: $(STAMP) test-deps
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n 2
 
 test-fast: $(STAMP)
 	$(BIN)/python -m pytest -q -m "not slow"
