@@ -92,6 +92,6 @@ def test_unknown_method_exits_4_naming_the_known_ones(tmp_path: Path) -> None:
     res = _cli("run", "--method", "nonesuch", cwd=tmp_path)
     assert res.returncode == 4
     assert res.stderr.strip().splitlines() == [
-        "error: unknown method 'nonesuch' (known: basso2012, toy)"
+        "error: unknown method 'nonesuch' (known: basso2012, cielniak2010, toy)"
     ]
     assert not (tmp_path / "runs").exists()

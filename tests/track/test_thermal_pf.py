@@ -126,6 +126,10 @@ def test_box_iou_hand_computed() -> None:
         np.array([[0.0, 0.0, 2.0, 2.0], [5.0, 5.0, 6.0, 6.0]]), np.array([1.0, 1.0, 3.0, 3.0])
     )
     np.testing.assert_allclose(iou, [1 / 7, 0.0])
+    # over the smaller box: (0,0,4,4) holds (1,1,2,2) entirely -> 1; IoU 1/16
+    big, small = np.array([[0.0, 0.0, 4.0, 4.0]]), np.array([1.0, 1.0, 2.0, 2.0])
+    assert box_iou(big, small, of_smaller=True)[0] == 1.0
+    assert box_iou(big, small)[0] == 1 / 16
 
 
 def test_systematic_resample_counts_follow_weights() -> None:

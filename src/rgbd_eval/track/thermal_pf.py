@@ -7,7 +7,9 @@ log-normal random walk of the size. The weight of a particle is
 ``exp(score / score_scale)`` with ``score`` the silhouette's thermal-gradient score
 (:mod:`rgbd_eval.track.silhouette`) on the unthresholded image, times the interaction
 factor: several filters run side by side, and a particle overlapping another filter's
-estimate is penalised by ``exp(-rho * IoU / score_scale)``: ``rho`` (K/px) is the score a
+estimate is penalised by ``exp(-rho * overlap / score_scale)`` (overlap: intersection over
+the smaller box, so that a small silhouette on a part of a tracked person, such as its
+legs, is penalised as fully as one on the whole person): ``rho`` (K/px) is the score a
 particle loses when it overlaps another estimate fully (seed 004, sections 3 and 6: the
 interaction factor rho prevents "target fetching", two filters converging on one person).
 The penalty is in the score's own units because the likelihood is sharp: a bounded
@@ -54,14 +56,16 @@ class FilterParams:
             raise ValueError(f"heights [{self.min_height}, {self.max_height}] must be increasing")
 
 
-def box_iou(boxes: F64, box: F64) -> F64:
-    """IoU of boxes (N, 4) with one box (4,), all ``(u0, v0, u1, v1)``."""
+def box_iou(boxes: F64, box: F64, *, of_smaller: bool = False) -> F64:
+    """IoU of boxes (N, 4) with one box (4,), all ``(u0, v0, u1, v1)``; with ``of_smaller``
+    the intersection over the smaller area (1 when one box lies inside the other)."""
     iw = np.clip(np.minimum(boxes[:, 2], box[2]) - np.maximum(boxes[:, 0], box[0]), 0.0, None)
     ih = np.clip(np.minimum(boxes[:, 3], box[3]) - np.maximum(boxes[:, 1], box[1]), 0.0, None)
     inter = iw * ih
     a = (boxes[:, 2] - boxes[:, 0]) * (boxes[:, 3] - boxes[:, 1])
     b = (box[2] - box[0]) * (box[3] - box[1])
-    out: F64 = inter / np.maximum(a + b - inter, 1e-9)
+    union = np.minimum(a, b) if of_smaller else a + b - inter
+    out: F64 = inter / np.maximum(union, 1e-9)
     return out
 
 
@@ -157,7 +161,7 @@ class ThermalParticleFilter:
         if others and q.rho > 0.0:
             boxes = state_boxes(self.particles, self.silhouette.width_ratio)
             for other in others:
-                scores = scores - q.rho * box_iou(boxes, np.asarray(other))
+                scores = scores - q.rho * box_iou(boxes, np.asarray(other), of_smaller=True)
         w = np.exp((scores - scores.max()) / q.score_scale)
         w /= w.sum()
         self.estimate = w @ self.particles
