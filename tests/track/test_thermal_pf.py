@@ -110,9 +110,11 @@ def test_interaction_factor_keeps_two_filters_on_two_people(rho: float) -> None:
     for seed in range(3):
         rng = np.random.default_rng(seed)
         on_b = ThermalParticleFilter.around(
-            params, SIL, np.array([190.0, 120, 150, 0, 0]), 0.05, rng
+            params, SIL, np.array([190.0, 120, 150, 0, 0, 1]), 0.05, rng
         )
-        new = ThermalParticleFilter.around(params, SIL, np.array([150.0, 120, 150, 0, 0]), 0.3, rng)
+        new = ThermalParticleFilter.around(
+            params, SIL, np.array([150.0, 120, 150, 0, 0, 1]), 0.3, rng
+        )
         for _ in range(30):
             step_filters([on_b, new], grad, 1 / 30)
         assert abs(on_b.estimate[0] - 190.0) < 5.0

@@ -50,7 +50,7 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     size_noise: float = Field(0.1, ge=0.0, description="log-size per sqrt(s)")
     score_scale: float = Field(0.2, gt=0.0, description="K/px")
     rho: float = Field(2.0, ge=0.0, description="interaction: K/px lost at full overlap")
-    min_height_px: float = Field(30.0, gt=0.0)
+    min_height_px: float = Field(50.0, gt=0.0)
     max_height_px: float = Field(400.0, gt=0.0)
     start_score: float = Field(0.6, ge=0.0, description="K/px to start a filter")
     start_spread: float = Field(0.1, gt=0.0, description="particle spread to start, heights")
@@ -177,7 +177,7 @@ class Cielniak2010Tracker:
         spread = float(np.hypot(*det.particles[:, :2].std(axis=0))) / max(float(est[2]), 1e-9)
         if det.score >= c.start_score and spread <= c.start_spread:
             state = est.copy()
-            state[3:] = 0.0
+            state[3:5] = 0.0  # at rest
             f = ThermalParticleFilter.around(self.params, self.silhouette, state, 0.05, self.rng)
             f.estimate = state
             f.score = float(silhouette_scores(grad, self.silhouette, state[None, :])[0])

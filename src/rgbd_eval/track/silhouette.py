@@ -93,7 +93,9 @@ class GradientImage:
 def silhouette_scores(grad: GradientImage, silhouette: Silhouette, states: F64) -> F64:
     """Mean outward-falling gradient (K/px) along the contour of each state ``(u, v, h, ...)``.
 
-    Contour points outside the image score 0 (nothing is measured there).
+    A sixth column, when present, is the width factor ``a`` (the silhouette's widths are
+    scaled by it: about 1 for a person seen from the front, 0.6-0.7 in profile). Contour
+    points outside the image score 0 (nothing is measured there).
     """
     if states.ndim != 2 or states.shape[1] < 3:
         raise ValueError(f"states shape {states.shape} must be (N, >=3)")
@@ -101,7 +103,8 @@ def silhouette_scores(grad: GradientImage, silhouette: Silhouette, states: F64) 
     u = states[:, 0:1]
     v = states[:, 1:2]
     h = states[:, 2:3]
-    px = np.rint(u + h * silhouette.points[:, 0]).astype(np.intp)  # (N, P)
+    a = states[:, 5:6] if states.shape[1] >= 6 else np.ones_like(h)
+    px = np.rint(u + h * a * silhouette.points[:, 0]).astype(np.intp)  # (N, P)
     py = np.rint(v + h * silhouette.points[:, 1]).astype(np.intp)
     inside = (px >= 0) & (px < W) & (py >= 0) & (py < H)
     pxc = np.clip(px, 0, W - 1)
@@ -115,8 +118,9 @@ def silhouette_scores(grad: GradientImage, silhouette: Silhouette, states: F64) 
 
 
 def state_boxes(states: F64, width_ratio: float) -> F64:
-    """Boxes ``(u0, v0, u1, v1)`` of states ``(u, v, h, ...)``."""
-    w = width_ratio * states[:, 2]
+    """Boxes ``(u0, v0, u1, v1)`` of states ``(u, v, h, ..., a)`` (``a``: width factor)."""
+    a = states[:, 5] if states.shape[1] >= 6 else 1.0
+    w = width_ratio * states[:, 2] * a
     h = states[:, 2]
     out: F64 = np.stack(
         [states[:, 0] - w / 2, states[:, 1] - h / 2, states[:, 0] + w / 2, states[:, 1] + h / 2],
