@@ -2,23 +2,32 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 from pathlib import Path
 from typing import Any
 
+from rgbd_eval.errors import OutputError
+from rgbd_eval.outdir import remove_stale, staging_name
+
 
 def write_bytes(path: Path, data: bytes) -> None:
     """Write ``data`` so that ``path`` is either absent, the old file, or the complete new one."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    tmp = path.with_name(staging_name(path.name))
     try:
+        if path.is_dir():
+            raise IsADirectoryError(21, "is a folder")
+        path.parent.mkdir(parents=True, exist_ok=True)
+        remove_stale(path.parent, path.name)
         tmp.write_bytes(data)
         os.replace(tmp, path)
+    except OSError as err:
+        raise OutputError(path, f"cannot write ({err.strerror})") from err
     finally:
-        if tmp.exists():
-            tmp.unlink()
+        with contextlib.suppress(OSError):
+            tmp.unlink(missing_ok=True)
 
 
 def write_text(path: Path, text: str) -> None:

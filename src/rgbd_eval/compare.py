@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import enum
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,7 +45,8 @@ class Status(enum.Enum):
     BETTER = "better"
     WORSE = "worse"  # worse, but within tolerance
     REGRESSED = "regressed"  # worse beyond tolerance
-    MISSING = "missing"  # one side has no value
+    MISSING = "missing"  # the baseline has a value, the current report none: a failure
+    NEW = "new"  # only the current report has a value
 
 
 @dataclass(frozen=True)
@@ -72,26 +74,79 @@ class Comparison:
 
     @property
     def regressions(self) -> tuple[Delta, ...]:
-        return tuple(d for d in self.deltas if d.status is Status.REGRESSED)
+        """Metrics worse beyond tolerance, or present in the baseline and missing now."""
+        return tuple(d for d in self.deltas if d.status in (Status.REGRESSED, Status.MISSING))
+
+
+def _refuse_constant(name: str) -> float:
+    raise ValueError(f"{name} is not a JSON number")
 
 
 def load_report(path: Path) -> dict[str, Any]:
     """A ``report.json`` (or a run folder holding one); CompareInputError when unusable."""
+    from rgbd_eval.files import read_text
+
     path = Path(path)
     if path.is_dir():
         path = path / "report.json"
+
+    def error(message: str) -> CompareInputError:
+        return CompareInputError(f"{path}: {message}")
+
+    text = read_text(path, error, "report")
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise CompareInputError(f"{path}: cannot read report ({err.strerror})") from err
+        data = json.loads(text, parse_constant=_refuse_constant)
     except json.JSONDecodeError as err:
         raise CompareInputError(f"{path}: not valid JSON ({err.msg} at line {err.lineno})") from err
+    except ValueError as err:  # NaN / Infinity
+        raise CompareInputError(f"{path}: not valid JSON ({err})") from err
     if not isinstance(data, dict) or data.get("schema_version") != REPORT_SCHEMA_VERSION:
         version = data.get("schema_version") if isinstance(data, dict) else None
         raise CompareInputError(
             f"{path}: report schema version {version!r}, this tool reads {REPORT_SCHEMA_VERSION}"
         )
+    check_report(data, str(path))
     return data
+
+
+def _number_or_none(value: Any) -> bool:
+    return value is None or (isinstance(value, int | float) and not isinstance(value, bool))
+
+
+def _check_metrics(metrics: Any, where: str) -> None:
+    if metrics is None:
+        return
+    if not isinstance(metrics, dict):
+        raise CompareInputError(f"{where}: 'metrics' must be an object or null")
+    for key, value in metrics.items():
+        if not _number_or_none(value):
+            raise CompareInputError(f"{where}: metric {key!r} is {value!r}, not a number or null")
+
+
+def check_report(data: Mapping[str, Any], source: str) -> None:
+    """The keys and types :func:`compare_reports` reads; CompareInputError naming the first bad one."""
+    evaluation = data.get("evaluation")
+    if not isinstance(evaluation, dict) or not isinstance(evaluation.get("gating"), str):
+        raise CompareInputError(f"{source}: no 'evaluation' object with a 'gating' name")
+    if not _number_or_none(evaluation.get("threshold")):
+        raise CompareInputError(f"{source}: 'evaluation.threshold' is not a number")
+    sequences = data.get("sequences")
+    if not isinstance(sequences, list):
+        raise CompareInputError(f"{source}: no 'sequences' list")
+    for k, seq in enumerate(sequences):
+        where = f"{source}: sequences[{k}]"
+        if not isinstance(seq, dict) or not isinstance(seq.get("name"), str):
+            raise CompareInputError(f"{where}: not an object with a 'name' string")
+        if "metrics" not in seq:
+            raise CompareInputError(f"{where} ({seq['name']}): no 'metrics' (null when unscored)")
+        _check_metrics(seq["metrics"], f"{where} ({seq['name']})")
+    overall = data.get("overall")
+    if overall is not None:
+        if not isinstance(overall, dict):
+            raise CompareInputError(f"{source}: 'overall' must be an object or null")
+        _check_metrics(overall.get("metrics"), f"{source}: overall")
+    if not isinstance(data.get("config", {}), dict):
+        raise CompareInputError(f"{source}: 'config' must be an object")
 
 
 def parse_tolerances(items: list[str]) -> dict[str, float]:
@@ -108,14 +163,16 @@ def parse_tolerances(items: list[str]) -> dict[str, float]:
             out[name] = float(value)
         except ValueError as err:
             raise CompareInputError(f"--tolerance {item!r}: {value!r} is not a number") from err
-        if out[name] < 0:
-            raise CompareInputError(f"--tolerance {item!r}: must be >= 0")
+        if not math.isfinite(out[name]) or out[name] < 0:
+            raise CompareInputError(f"--tolerance {item!r}: must be a finite number >= 0")
     return out
 
 
 def _status(base: float | None, cur: float | None, better: Better, tol: float) -> Status:
     if base is None or cur is None:
-        return Status.SAME if base is None and cur is None else Status.MISSING
+        if base is None:
+            return Status.SAME if cur is None else Status.NEW
+        return Status.MISSING  # scored in the baseline, lost in the current report: fails
     gain = (cur - base) if better is Better.HIGHER else (base - cur)
     if abs(gain) <= 1e-12:
         return Status.SAME
@@ -188,6 +245,10 @@ def compare_reports(
             b = None if base is None else base.get(metric)
             c = None if cur is None else cur.get(metric)
             deltas.append(Delta(seq, metric, b, c, tol, _status(b, c, better, tol)))
+        for metric in sorted(set(base or {}) - set(DEFAULT_TOLERANCES)):
+            b, c = (base or {})[metric], (cur or {}).get(metric)
+            if b is not None and c is None:  # not gated by value, but must not vanish
+                deltas.append(Delta(seq, metric, b, None, 0.0, Status.MISSING))
     flat_b: dict[str, Any] = {}
     flat_c: dict[str, Any] = {}
     flatten("", baseline.get("config", {}), flat_b)

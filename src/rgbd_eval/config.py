@@ -32,7 +32,9 @@ from rgbd_eval.errors import ConfigError
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True, validate_default=True)
+    model_config = ConfigDict(
+        extra="forbid", frozen=True, validate_default=True, allow_inf_nan=False
+    )
 
 
 class ComponentConfig(_Model):
@@ -244,7 +246,7 @@ def validation_parts(err: ValidationError, prefix: str = "") -> list[tuple[str, 
         if e["type"] == "extra_forbidden":
             msg = "unknown key"
         value = e.get("input")
-        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r})"
+        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r:.80})"
         parts.append((loc, f"{msg}{shown}"))
     return parts
 
@@ -339,6 +341,7 @@ def build_config(
     data: Mapping[str, Any] | None = None,
     overrides: Iterable[tuple[str, Any]] = (),
     source: str = "config",
+    override_source: str | None = None,
 ) -> RunConfig:
     """Validate a config mapping with overrides applied on top.
 
@@ -383,14 +386,12 @@ def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:
 
 def load_yaml(path: Path) -> dict[str, Any]:
     """Read a YAML mapping, as a :class:`ConfigError` on any failure."""
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except OSError as err:
-        raise ConfigError(f"{path}: cannot read config ({err.strerror})") from err
-    try:
-        data = yaml.safe_load(text)
-    except yaml.YAMLError as err:
-        raise ConfigError(f"{path}: not valid YAML ({err})") from err
+    from rgbd_eval.files import parse_yaml, read_text
+
+    def error(message: str) -> ConfigError:
+        return ConfigError(f"{path}: {message}")
+
+    data = parse_yaml(read_text(Path(path), error, "config"), error)
     if data is None:
         return {}
     if not isinstance(data, dict):

@@ -14,7 +14,8 @@ Exit codes (also in README.md):
 4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
 6     the run could not be scored
-7     an output could not be written (e.g. no MP4 encoder for ``--video``)
+7     an output cannot be written (not a folder, not writable, someone else's folder,
+      no MP4 encoder for ``--video``)
 ====  =====================================================================
 """
 
@@ -86,7 +87,7 @@ class CompareInputError(RgbdEvalError):
 
 
 class OutputError(RgbdEvalError):
-    """An output file could not be written."""
+    """An output file or folder cannot be written (or would overwrite a user's files)."""
 
     exit_code = 7
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from rgbd_eval.config import Gating, RunConfig
 from rgbd_eval.detect.protocol import create_detector
-from rgbd_eval.errors import ConfigError, InputError, ScoringError
+from rgbd_eval.errors import ConfigError, GroundTruthError, InputError, ScoringError
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
 from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence
@@ -231,6 +231,8 @@ def score_sequence(
             f"{gt.source}: none of its {gt.annotated_frames} annotated frames matches a frame "
             f"stamp of the recording (within {config.io.max_sync_gap_ms} ms)"
         )
+    if gt.annotated_frames == 0:
+        raise GroundTruthError(gt.source, "holds no annotated object (only a header?)")
     needs = "box2d" if config.evaluation.gating is Gating.IOU else "world_xyz"
     if not any(getattr(o, needs) is not None for frame in gt.frames for o in frame):
         other = "metric" if config.evaluation.gating is Gating.IOU else "iou"
@@ -266,7 +268,7 @@ def run_sequence(
     return SequenceResult(
         name=sequence_name(path),
         path=str(path),
-        info=recording.info,
+        info=replace(recording.info, warnings=recording.info.warnings + recording.frame_warnings),
         detections=detections,
         tracks=tracks,
         ground_truth=matched,

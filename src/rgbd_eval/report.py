@@ -10,11 +10,7 @@ from __future__ import annotations
 import csv
 import hashlib
 import io
-import os
-import shutil
-import tempfile
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
@@ -22,11 +18,13 @@ from typing import Any
 
 from rgbd_eval import __version__
 from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
-from rgbd_eval.errors import ConfigError
 from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
+from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.pipeline import SequenceResult
 
 REPORT_SCHEMA_VERSION = 1
+#: The file that marks a run folder as ours (and that ``compare`` reads).
+REPORT_FILE = "report.json"
 _LIBRARIES = (
     "numpy",
     "scipy",
@@ -322,34 +320,15 @@ def events_csv(
     return _csv(rows, EVENTS_HEADER)
 
 
-@contextmanager
-def staged_output(out_dir: Path) -> Iterator[Path]:
-    """A temporary folder beside ``out_dir`` that replaces it only if the block succeeds."""
-    out_dir = Path(out_dir)
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    if out_dir.exists() and any(out_dir.iterdir()) and not (out_dir / "report.json").exists():
-        raise ConfigError(
-            f"{out_dir}: exists and is not an rgbd-eval output folder; choose another --out"
-        )
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out_dir.name}.tmp-", dir=out_dir.parent))
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    os.replace(tmp, out_dir)
-
-
 def write_run(
-    out_dir: Path,
+    out: Path | OutputFolder,
     results: Sequence[SequenceResult],
     config: RunConfig,
     also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write every output of a run into ``out_dir`` (atomically as a folder); return the report.
+    """Write every output of a run into ``out`` (published when complete); return the report.
 
+    ``out`` is a folder path, or an :class:`OutputFolder` prepared before the pipeline ran.
     ``also(folder, report)`` writes further outputs (the HTML page and its plots) into the
     staged folder.
     """
@@ -357,7 +336,9 @@ def write_run(
 
     digests = [file_digest(Path(r.path)) for r in results]
     report = report_dict(results, config, digests)
-    with staged_output(out_dir) as tmp:
+    folder = out if isinstance(out, OutputFolder) else OutputFolder(out, REPORT_FILE)
+    with folder:
+        tmp = folder.staging
         for r in results:
             (tmp / f"{r.name}.detections.csv").write_text(detections_csv(r), encoding="utf-8")
             (tmp / f"{r.name}.tracks.csv").write_text(tracks_csv(r), encoding="utf-8")
@@ -377,9 +358,10 @@ def write_run(
             md.append(markdown_table(results, config.evaluation.gating))
         md += [f"- {note}" for note in run_notes(results)]
         (tmp / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
-        (tmp / "report.json").write_text(
+        (tmp / REPORT_FILE).write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
         )
         if also is not None:
             also(tmp, report)
+        folder.commit()
     return report

@@ -19,6 +19,7 @@ from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
 from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
+from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.report import (
     COLUMNS,
     MATCHING,
@@ -27,7 +28,6 @@ from rgbd_eval.report import (
     file_digest,
     format_value,
     library_versions,
-    staged_output,
 )
 
 
@@ -170,7 +170,8 @@ def write_report(
         "",
         *(f"- {s.name}: warning: {w}" for s in sequences for w in s.warnings),
     ]
-    with staged_output(out_dir) as tmp:
+    with OutputFolder(out_dir, "report.json") as folder:
+        tmp = folder.staging
         for s in sequences:
             (tmp / f"{s.name}.events.csv").write_text(
                 events_csv(s.scores.frames, s.aligned.stamps_ns, s.aligned.frame_numbers),
@@ -182,4 +183,5 @@ def write_report(
         )
         if also is not None:
             also(tmp, report)
+        folder.commit()
     return report

@@ -1,12 +1,12 @@
-"""Scoring speed on a thesis-sized sequence: 750 frames, 3 people (seed 000, chapter 7).
+"""Scoring a thesis-sized sequence: 750 frames, 3 people (seed 000, chapter 7).
 
-Run with ``pytest tests/metrics/test_metrics_benchmark.py -m slow -s`` to see the time.
+No wall-clock assertion: on a loaded 2-core machine ``best < 5.0`` failed (issue 21).
+Timing belongs in ``rgbd-eval bench``, which reports the scoring stage per frame.
 """
 
 from __future__ import annotations
 
 import math
-import time
 
 import numpy as np
 import pytest
@@ -43,16 +43,12 @@ def _sequence() -> tuple[list[list[GroundTruthObject]], list[list[TrackOutput]]]
 
 @pytest.mark.slow
 @pytest.mark.parametrize("gating", list(Gating))
-def test_scoring_a_thesis_sized_sequence_is_fast(gating: Gating) -> None:
+def test_scoring_a_thesis_sized_sequence(gating: Gating) -> None:
     gts, tracks = _sequence()
     config = EvaluationConfig(gating=gating)
-    evaluate_sequence(gts[:10], tracks[:10], config)  # warm up imports
-    best = math.inf
-    for _ in range(3):
-        start = time.perf_counter()
-        scores = evaluate_sequence(gts, tracks, config)
-        best = min(best, time.perf_counter() - start)
-    print(f"\n{gating.value}: {N_FRAMES} frames x {N_PEOPLE} people scored in {best * 1e3:.0f} ms")
+    scores = evaluate_sequence(gts, tracks, config)
     assert scores.counts.num_gt == N_FRAMES * N_PEOPLE
     assert scores.counts.id_switches >= N_PEOPLE  # the ids change at frames 300 and 600
-    assert best < 5.0  # generous: about 0.2-0.3 s on one shared core
+    # Every instance is matched or missed; the same input scores the same, bit for bit.
+    assert scores.counts.num_matches + scores.counts.fn == N_FRAMES * N_PEOPLE
+    assert evaluate_sequence(gts, tracks, config).counts == scores.counts

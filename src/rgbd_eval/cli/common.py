@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import signal
 import sys
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -53,6 +54,27 @@ def advance_callback(bar: Progress, task: TaskID) -> Callable[[int, int], None]:
     return advance
 
 
+#: Longest error line printed; longer messages (e.g. a value that expanded) are cut.
+MAX_MESSAGE_CHARS = 600
+
+
+class Interrupted(BaseException):
+    """A termination signal (SIGTERM, SIGHUP) turned into an exception, as SIGINT is."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(f"signal {signum}")
+        self.signum = signum
+
+
+def one_line(message: str) -> str:
+    """``message`` on one line (whitespace runs collapsed) and at most MAX_MESSAGE_CHARS long."""
+    text = " ".join(message.split())
+    if len(text) > MAX_MESSAGE_CHARS:
+        cut = len(text) - MAX_MESSAGE_CHARS
+        text = f"{text[:MAX_MESSAGE_CHARS]}... ({cut} more characters)"
+    return text
+
+
 def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
     """Turn the package's errors into one ``error:`` line on stderr and their exit code."""
 
@@ -61,9 +83,14 @@ def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
         try:
             return func(*args, **kwargs)
         except RgbdEvalError as err:
-            message = " ".join(str(err).split())
-            typer.echo(f"error: {message}", err=True)
+            typer.echo(f"error: {one_line(str(err))}", err=True)
             raise typer.Exit(err.exit_code) from None
+        except KeyboardInterrupt:  # outputs were removed on the way out (staged folders)
+            typer.echo("error: interrupted", err=True)
+            raise typer.Exit(128 + signal.SIGINT) from None
+        except Interrupted as err:
+            typer.echo(f"error: interrupted by signal {err.signum}", err=True)
+            raise typer.Exit(128 + err.signum) from None
 
     return wrapper
 

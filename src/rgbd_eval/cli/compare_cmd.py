@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from rgbd_eval.atomic import write_text
-from rgbd_eval.cli.common import console, handle_errors
+from rgbd_eval.cli.common import console, handle_errors, one_line
 
 
 @handle_errors
@@ -63,9 +63,15 @@ def compare(
 
         write_text(html_file, compare_page(comparison, str(baseline), str(current)))
     if comparison.regressions:
-        names = ", ".join(f"{d.sequence}/{d.metric}" for d in comparison.regressions)
-        console.print(
-            f"[bold red]{len(comparison.regressions)} regression(s) beyond tolerance:[/] {names}"
-        )
+        lost = [d for d in comparison.regressions if d.status is Status.MISSING]
+        worse = [d for d in comparison.regressions if d.status is Status.REGRESSED]
+        reasons = []
+        if worse:
+            names = ", ".join(f"{d.sequence}/{d.metric}" for d in worse)
+            reasons.append(f"{len(worse)} regression(s) beyond tolerance: {names}")
+        if lost:
+            names = ", ".join(f"{d.sequence}/{d.metric}" for d in lost)
+            reasons.append(f"{len(lost)} metric(s) scored in the baseline but missing now: {names}")
+        typer.echo(f"error: {one_line('; '.join(reasons))}", err=True)
         raise typer.Exit(1)
     console.print("no regression beyond tolerance")

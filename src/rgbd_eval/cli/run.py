@@ -21,6 +21,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.errors import InputError
+from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
     from rgbd_eval.pipeline import SequenceResult
@@ -122,11 +123,15 @@ def run(
         bool,
         typer.Option("--video", help="also write <name>.overlay.mp4: tracks on the RGB frames"),
     ] = False,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
-    from rgbd_eval.report import write_run
+    from rgbd_eval.report import REPORT_FILE, write_run
     from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
@@ -145,19 +150,18 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with progress_bar() as bar:
-        for path in recordings:
+    with OutputFolder(out_dir, REPORT_FILE, force) as folder, progress_bar() as bar:
+        for path in recordings:  # the output folder is checked and staged before this work
             task = bar.add_task(path.name, total=None)
             results.append(run_sequence(path, config, gt, advance_callback(bar, task)))
             bar.remove_task(task)
-    with progress_bar() as bar:
         task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
         report = write_run(
-            out_dir,
+            folder,
             results,
             config,
-            lambda folder, rep: write_run_html(
-                folder, results, config, rep, video, advance_callback(bar, task)
+            lambda staging, rep: write_run_html(
+                staging, results, config, rep, video, advance_callback(bar, task)
             ),
         )
     if json_out:

@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import csv
 import io
+import json
 import time
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.table import Table
@@ -20,6 +21,10 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import Gating, load_yaml, parse_overrides
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.outdir import OutputFolder
+
+if TYPE_CHECKING:
+    from rgbd_eval.sweep import SweepResult
 
 
 def _csv(rows: list[dict[str, Any]]) -> str:
@@ -28,6 +33,42 @@ def _csv(rows: list[dict[str, Any]]) -> str:
     writer.writeheader()
     writer.writerows(rows)
     return buf.getvalue()
+
+
+def _write_outputs(
+    folder: OutputFolder,
+    result: SweepResult,
+    wall: float,
+    method: str,
+    recordings: list[Path],
+    fixed: list[str],
+    gating: Gating,
+) -> None:
+    """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
+    folder, then publish."""
+    from rgbd_eval.report_html import write_sweep_html
+
+    tmp = folder.staging
+    rows = result.rows()
+    (tmp / "sweep.csv").write_text(_csv(rows), encoding="utf-8")
+    write_sweep_html(tmp, result, method, [str(p) for p in recordings], fixed, gating)
+    record = {
+        "schema_version": SCHEMA_VERSION,
+        "params": list(result.params),
+        "method": method,
+        "datasets": [str(p) for p in recordings],
+        "fixed": fixed,
+        "records": rows,
+        "seconds": {
+            "wall": wall,
+            "detect": result.detect_seconds,
+            "track_score": result.track_seconds,
+        },
+        "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
+    }
+    text = json.dumps(record, indent=2, allow_nan=False) + "\n"
+    (tmp / "sweep.json").write_text(text, encoding="utf-8")
+    folder.commit()
 
 
 @handle_errors
@@ -57,15 +98,17 @@ def sweep(
         Path | None, typer.Option(help="output folder (default runs/sweep-<time>)")
     ] = None,
     cache: Annotated[Path | None, typer.Option(help="detection cache folder")] = None,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
     topics: TopicOption = None,
 ) -> None:
     """Sweep config keys over datasets; records as CSV + JSON, a plot and a table."""
     from rgbd_eval import datasets
-    from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.config import load_config
     from rgbd_eval.metrics import summarize
     from rgbd_eval.report import format_value
-    from rgbd_eval.report_html import write_sweep_html
     from rgbd_eval.sweep import (
         SweepParam,
         default_jobs,
@@ -109,31 +152,13 @@ def sweep(
     out_dir = out or Path("runs") / f"sweep-{time.strftime('%Y%m%d-%H%M%S')}"
     jobs = jobs if jobs is not None else default_jobs()
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {jobs} job(s)")
-    start = time.perf_counter()
-    result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
-    wall = time.perf_counter() - start
-    rows = result.rows()
-    out_dir.mkdir(parents=True, exist_ok=True)
-    write_text(out_dir / "sweep.csv", _csv(rows))
-    write_json(
-        out_dir / "sweep.json",
-        {
-            "schema_version": SCHEMA_VERSION,
-            "params": list(result.params),
-            "method": method,
-            "datasets": [str(p) for p in recordings],
-            "fixed": fixed,
-            "records": rows,
-            "seconds": {
-                "wall": wall,
-                "detect": result.detect_seconds,
-                "track_score": result.track_seconds,
-            },
-            "cache": {"hits": result.cache_hits, "misses": result.cache_misses},
-        },
-    )
     g = configs[0].evaluation.gating if configs else Gating.IOU
-    write_sweep_html(out_dir, result, method, [str(p) for p in recordings], fixed, g)
+    folder = OutputFolder(out_dir, "sweep.json", force)
+    with folder:  # checked and staged before the sweep; published whole or not at all
+        start = time.perf_counter()
+        result = run_sweep(recordings, grid, configs, jobs=jobs, cache_root=cache)
+        wall = time.perf_counter() - start
+        _write_outputs(folder, result, wall, method, recordings, fixed, g)
     table = Table(title=f"{', '.join(result.params)} (all sequences summed)", title_justify="left")
     heads = [*result.params, "MOTP", "MOTA", "FP", "FN", "ID Sw.", "Main Tr.", "All Tr."]
     for h in heads:

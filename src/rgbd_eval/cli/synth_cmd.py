@@ -9,6 +9,7 @@ import typer
 
 from rgbd_eval.cli.common import advance_callback, console, handle_errors, progress_bar
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.outdir import check_output_file
 
 
 def _scenario_file(name_or_path: str) -> Path:
@@ -60,6 +61,9 @@ def synth(
     if out is not None and out.suffix not in ("", f".{fmt}"):
         raise ConfigError(f"--out {out}: a {fmt} recording needs a .{fmt} name")
     container: Literal["ros1", "mcap"] = "ros1" if fmt == "bag" else "mcap"
+    for target in (out, preview):
+        if target is not None:
+            check_output_file(target)  # before rendering; never replaces a folder
     if all_scenarios:
         if scenario is not None or out is not None or preview is not None:
             raise ConfigError(

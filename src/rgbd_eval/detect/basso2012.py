@@ -22,7 +22,7 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
+from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig, GroundMode
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -52,6 +52,7 @@ from rgbd_eval.detect.features import (
 from rgbd_eval.detect.ground import GroundPlaneEstimator
 from rgbd_eval.detect.hog import hog_confidences
 from rgbd_eval.detect.plane import signed_heights
+from rgbd_eval.errors import ConfigError
 from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Box2D, Box3D, CameraModel, Detection, Frame
 
@@ -148,6 +149,7 @@ class Basso2012Detector:
 
     def _ground_plane(self, frame: Frame, cloud: PointCloud, grid: VoxelGrid) -> FloatArray | None:
         if self.ground.plane is None:
+            _check_ground_pixels(self.config, frame.rgb_camera)
             uv, _ = project_to_rgb(cloud.points, frame.depth_to_rgb, frame.rgb_camera)
             plane = self.ground.initialise(
                 grid.centroids,
@@ -352,6 +354,21 @@ def _world_box(frame: Frame, points: FloatArray) -> Box3D:
     return Box3D(
         (float(lo[0]), float(lo[1]), float(lo[2])), (float(hi[0]), float(hi[1]), float(hi[2]))
     )
+
+
+def _check_ground_pixels(cfg: Basso2012DetectorConfig, camera: CameraModel) -> None:
+    """ConfigError when a configured floor pixel is off the RGB image (no floor would be found)."""
+    if cfg.ground_mode is not GroundMode.POINTS:
+        return
+    outside = [
+        (u, v)
+        for u, v in cfg.ground_pixels or ()
+        if not (0 <= u < camera.width and 0 <= v < camera.height)
+    ]
+    if outside:
+        raise ConfigError(
+            f"detector.ground_pixels: {outside} off the {camera.width}x{camera.height} RGB image"
+        )
 
 
 def _check_frame(frame: Frame) -> None:

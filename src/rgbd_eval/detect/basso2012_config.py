@@ -5,9 +5,11 @@ from __future__ import annotations
 import enum
 from typing import Literal
 
+import numpy as np
 from pydantic import Field, model_validator
 
 from rgbd_eval.config import ComponentConfig
+from rgbd_eval.detect.plane import normalise_plane, plane_from_points
 
 
 class GroundMode(enum.Enum):
@@ -117,4 +119,11 @@ class Basso2012DetectorConfig(ComponentConfig):
             )
         if self.ground_mode is GroundMode.PLANE and self.ground_plane is None:
             raise ValueError("ground_mode 'plane' needs ground_plane: [a, b, c, d]")
+        # The detector's own plane checks, at load time rather than mid-run (issue 21).
+        if self.ground_plane is not None:
+            normalise_plane(self.ground_plane)
+        if self.ground_points is not None and len(self.ground_points) == 3:
+            plane_from_points(*(np.asarray(p, dtype=np.float64) for p in self.ground_points))
+        if self.ground_pixels is not None and any(u < 0 or v < 0 for u, v in self.ground_pixels):
+            raise ValueError(f"ground_pixels={self.ground_pixels}: pixel coordinates must be >= 0")
         return self

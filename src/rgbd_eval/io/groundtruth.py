@@ -16,6 +16,7 @@ KTP text (Kinect Tracking Precision dataset), one line per frame::
 from __future__ import annotations
 
 import csv
+import io
 import math
 import os
 from collections.abc import Iterable, Sequence
@@ -27,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from rgbd_eval.errors import GroundTruthError
+from rgbd_eval.files import check_input, read_text
 from rgbd_eval.types import Box2D, GroundTruthObject
 
 CSV_COLUMNS = (
@@ -132,43 +134,81 @@ def _group(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
 # ----------------------------------------------------------------------------- CSV
 
 
+#: Ids must be exact in a float64 (the metrics' arrays): smaller than 2**53 in magnitude.
+MAX_ID = 2**53
+
+
 def _opt_float(value: str) -> float | None:
     value = value.strip()
-    if value == "" or value.lower() == "nan":
+    if value == "":
         return None
-    return float(value)
+    number = float(value)
+    if not math.isfinite(number):
+        raise ValueError(f"{value!r} is not a finite number (leave the field empty if unknown)")
+    return number
+
+
+def _id(text: str) -> int:
+    value = int(text)
+    if abs(value) >= MAX_ID:
+        raise ValueError(f"id {value} is not smaller than 2**53 in magnitude")
+    return value
+
+
+def _one_box(values: Sequence[float | None], what: str) -> bool:
+    """True when all of ``values`` are given, False when none is; ValueError when only some are."""
+    given = sum(v is not None for v in values)
+    if 0 < given < len(values):
+        raise ValueError(f"{what} fields are only partly given (give all or leave all empty)")
+    return given == len(values)
 
 
 def read_csv(path: Path) -> GroundTruth:
     """Read the sidecar CSV; any malformed line is a :class:`GroundTruthError` naming it."""
     path = Path(path)
-    try:
-        handle = path.open(newline="", encoding="utf-8")
-    except OSError as err:
-        raise GroundTruthError(path, f"cannot read ground truth ({err.strerror})") from err
+    text = read_text(path, lambda m: GroundTruthError(path, m), "ground truth")
     objects = []
-    with handle:
+    with io.StringIO(text, newline="") as handle:
         reader = csv.DictReader(handle)
-        missing = [c for c in _REQUIRED if c not in (reader.fieldnames or [])]
+        try:
+            fieldnames = reader.fieldnames or []
+        except csv.Error as err:
+            raise GroundTruthError(path, f"line 1: not CSV ({err})") from err
+        missing = [c for c in _REQUIRED if c not in fieldnames]
         if missing:
             raise GroundTruthError(
                 path, f"missing columns {', '.join(missing)}; expected {','.join(CSV_COLUMNS)}"
             )
-        for row in reader:
+        rows = iter(reader)
+        while True:
+            try:
+                row = next(rows)
+            except StopIteration:
+                break
+            except csv.Error as err:
+                raise GroundTruthError(path, f"line {reader.line_num}: not CSV ({err})") from err
             line = reader.line_num
+            if None in row.values():
+                raise GroundTruthError(
+                    path, f"line {line}: fewer fields than the {len(fieldnames)} columns"
+                )
+            if None in row:
+                raise GroundTruthError(
+                    path, f"line {line}: more fields than the {len(fieldnames)} columns"
+                )
             try:
                 box_vals = [
                     _opt_float(row[c]) for c in ("bb_left", "bb_top", "bb_width", "bb_height")
                 ]
                 xyz = [_opt_float(row[c]) for c in ("x", "y", "z")]
                 box = None
-                if all(v is not None for v in box_vals):
+                if _one_box(box_vals, "box"):
                     left, top, width, height = (float(v) for v in box_vals if v is not None)
                     if width < 0 or height < 0:
                         raise ValueError(f"negative box size {width}x{height}")
                     box = Box2D(left, top, width, height) if width > 0 and height > 0 else None
                 world = None
-                if all(v is not None for v in xyz):
+                if _one_box(xyz, "x/y/z"):
                     world = (float(xyz[0] or 0.0), float(xyz[1] or 0.0), float(xyz[2] or 0.0))
                 visibility = float(row["visibility"]) if row["visibility"].strip() else 1.0
                 if not 0.0 <= visibility <= 1.0:
@@ -178,7 +218,7 @@ def read_csv(path: Path) -> GroundTruth:
                     GroundTruthObject(
                         frame=int(row["frame"]),
                         stamp_ns=int(row["stamp_ns"] or 0),
-                        object_id=int(row["id"]),
+                        object_id=_id(row["id"]),
                         box2d=box,
                         world_xyz=world,
                         visibility=visibility,
@@ -225,16 +265,17 @@ def write_csv(path: Path, objects: Iterable[GroundTruthObject]) -> None:
 
 
 def _stamp_ns(text: str) -> int:
-    return int(Decimal(text.strip()) * 1_000_000_000)
+    """Seconds as text -> ns; InvalidOperation unless a finite number."""
+    value = Decimal(text.strip())
+    if not value.is_finite():
+        raise InvalidOperation(f"{text.strip()!r} is not finite")
+    return int(value * 1_000_000_000)
 
 
 def read_ktp(path: Path) -> GroundTruth:
     """Read a KTP ground-truth text file (2D boxes or 3D positions, detected per file)."""
     path = Path(path)
-    try:
-        lines = path.read_text(encoding="utf-8").splitlines()
-    except OSError as err:
-        raise GroundTruthError(path, f"cannot read ground truth ({err.strerror})") from err
+    lines = read_text(path, lambda m: GroundTruthError(path, m), "ground truth").splitlines()
     objects = []
     arity: int | None = None
     frame = -1
@@ -261,12 +302,18 @@ def read_ktp(path: Path) -> GroundTruth:
             elif arity != len(values):
                 raise GroundTruthError(path, f"line {number}: mixes 2D and 3D entries")
             try:
-                oid = int(values[0])
+                oid = _id(values[0])
                 nums = [float(v) for v in values[1:]]
             except ValueError as err:
                 raise GroundTruthError(path, f"line {number}: {err}") from err
+            if not all(math.isfinite(v) for v in nums):
+                raise GroundTruthError(path, f"line {number}: entry {entry!r} is not finite")
             if all(v == 0.0 for v in nums):
                 continue  # 0 0 0 (0) means the person is not annotated in this frame
+            if arity == 5 and (nums[2] < 0 or nums[3] < 0):
+                raise GroundTruthError(
+                    path, f"line {number}: entry {entry!r} has a negative box width or height"
+                )
             if arity == 5:
                 obj = GroundTruthObject(frame, stamp, oid, Box2D(*nums), None)
             else:
@@ -308,6 +355,7 @@ def load_ground_truth(path: Path) -> GroundTruth:
     path = Path(path)
     if not path.exists():
         raise GroundTruthError(path, "ground-truth file not found")
+    check_input(path, lambda m: GroundTruthError(path, m), "ground truth")
     if path.suffix.lower() == ".csv":
         return read_csv(path)
     return read_ktp(path)

@@ -66,7 +66,7 @@ def image_array(msg: Any) -> NDArray[Any]:
     height, width, step = int(msg.height), int(msg.width), int(msg.step)
     row_bytes = width * channels * dtype.itemsize
     data = np.asarray(msg.data, dtype=np.uint8)
-    if step < row_bytes or data.size < step * height:
+    if step < row_bytes or data.size != step * height:  # ROS: data holds step * height bytes
         raise ImageFormatError(
             f"{msg.encoding} image {width}x{height} needs {row_bytes} bytes per row and "
             f"{step * height} in all, message has step {step} and {data.size} bytes"

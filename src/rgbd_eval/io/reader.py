@@ -38,7 +38,8 @@ from rgbd_eval.errors import (
     TopicError,
     TransformError,
 )
-from rgbd_eval.io import groundtruth, images
+from rgbd_eval.files import check_input
+from rgbd_eval.io import groundtruth, images, validate
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -250,6 +251,13 @@ class Recording:
         self._plan = plan
         self._depth_to_rgb = depth_to_rgb
         self.ground_truth_topic = ground_truth
+        self.empty_depth_frames: list[int] = []  # indices, filled while frames() runs
+
+    @property
+    def frame_warnings(self) -> tuple[str, ...]:
+        """Warnings found while decoding (after :meth:`frames` ran): empty depth frames."""
+        warning = validate.empty_depth_warning(self.empty_depth_frames, len(self._plan))
+        return () if warning is None else (warning,)
 
     def __len__(self) -> int:
         return len(self._plan)
@@ -267,6 +275,7 @@ class Recording:
         counters = dict.fromkeys(sel.values(), 0)
         primary = "depth" if "depth" in sel else next(iter(sel))
         next_k = 0
+        self.empty_depth_frames = []
         info = self.info
         try:
             with open_source(self.path) as src:
@@ -279,9 +288,10 @@ class Recording:
                     if k is None:
                         continue
                     msg = src.deserialize(raw, msgtypes[topic])
-                    ready.setdefault(k, {})[role] = self._decode(
-                        msg, topic, role, info.cameras[role]
-                    )
+                    decoded = self._decode(msg, topic, role, info.cameras[role])
+                    if role == "depth" and validate.depth_is_empty(decoded[0]):
+                        self.empty_depth_frames.append(k)
+                    ready.setdefault(k, {})[role] = decoded
                     while len(ready.get(next_k, ())) == len(sel):
                         plan = self._plan[next_k]
                         images = ready.pop(next_k)
@@ -311,6 +321,8 @@ class Recording:
             raise InputError(
                 self.path, f"recording ended after {next_k} of {len(self._plan)} indexed frames"
             )
+        if next_k and len(self.empty_depth_frames) == next_k:
+            raise DecodeError(self.path, "no depth frame holds a valid pixel", sel["depth"])
 
     def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
         kind = role_kind(role)
@@ -326,6 +338,8 @@ class Recording:
                 encoding = "rgb8"
         except images.ImageFormatError as err:
             raise DecodeError(self.path, str(err), topic) from err
+        if (problem := validate.image_size_problem(img)) is not None:
+            raise DecodeError(self.path, problem, topic)
         if img.shape[:2] != (camera.height, camera.width):
             raise DecodeError(
                 self.path,
@@ -495,6 +509,7 @@ def open_recording(
     io = io or IoConfig()
     if not path.exists():
         raise InputError(path, "no such file or folder")
+    check_input(path, lambda m: InputError(path, m), "recording", allow_dir=True)
     kind = container_kind(path)
     warnings: list[str] = []
     try:

@@ -7,7 +7,9 @@ everything else (ROS1 bags, ROS2 folders, ``.db3``) goes through AnyReader.
 
 from __future__ import annotations
 
+import sqlite3
 import struct
+import zlib
 from collections.abc import Iterator
 from contextlib import AbstractContextManager
 from dataclasses import dataclass
@@ -16,6 +18,8 @@ from pathlib import Path
 from types import TracebackType
 from typing import IO, Any
 
+import apsw
+import zstandard
 from mcap.exceptions import McapError
 from mcap.reader import McapReader, make_reader
 from rosbags.highlevel import AnyReader, AnyReaderError
@@ -39,7 +43,10 @@ READ_ERRORS: tuple[type[BaseException], ...] = (
     OSError,
     struct.error,
     EOFError,
-    ValueError,
+    ValueError,  # includes mcap's CRCValidationError
+    zstandard.ZstdError,  # a corrupt zstd chunk (MCAP, ROS2 mcap storage)
+    apsw.Error,  # a corrupt ROS2 sqlite3 database
+    sqlite3.Error,
 )
 
 
@@ -84,6 +91,8 @@ class AnyReaderSource(MessageSource):
 
     def __init__(self, path: Path) -> None:
         self.ros1 = path.suffix == ".bag"
+        if path.is_file():
+            check_magic(path)
         self._reader = AnyReader([path], default_typestore=typestore(1 if self.ros1 else 2))
         self._reader.open()
         self._conns = {c.topic: c for c in self._reader.connections}
@@ -102,7 +111,10 @@ class AnyReaderSource(MessageSource):
             yield conn.topic, log_ns, raw
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
-        return self._reader.deserialize(bytes(raw), msgtype)
+        try:
+            return self._reader.deserialize(bytes(raw), msgtype)
+        except KeyError as err:  # a damaged type table names a type the typestore lacks
+            raise ValueError(f"message type {msgtype!r} has no definition") from err
 
     def close(self) -> None:
         self._reader.close()
@@ -114,15 +126,22 @@ class McapSource(MessageSource):
     def __init__(self, path: Path) -> None:
         self._handle: IO[bytes] = path.open("rb")
         try:
-            self._reader: McapReader = make_reader(self._handle)
+            verify_summary_crc(self._handle)
+            # Chunk CRCs are checked whenever a chunk is decompressed: in the index pass
+            # and again in the frame pass (each opens its own source).
+            self._reader: McapReader = make_reader(self._handle, validate_crcs=True)
             summary = self._reader.get_summary()
+            if summary is None:
+                raise McapError("no summary section (file truncated or written without an index)")
+            if summary.statistics is not None:
+                counts = dict(summary.statistics.channel_message_counts)
+            else:  # no statistics record: count in one extra pass over the chunks
+                counts = {}
+                for _, channel, _ in self._reader.iter_messages():
+                    counts[channel.id] = counts.get(channel.id, 0) + 1
         except BaseException:
             self._handle.close()
             raise
-        if summary is None:
-            self._handle.close()
-            raise McapError("no summary section (file truncated or written without an index)")
-        counts = summary.statistics.channel_message_counts if summary.statistics else {}
         self.topics = {}
         schemas: dict[str, bytes] = {}  # empty text: not ros2msg (e.g. ros2idl)
         for cid, channel in summary.channels.items():
@@ -137,6 +156,9 @@ class McapSource(MessageSource):
         if summary.statistics is not None:
             self.start_ns = summary.statistics.message_start_time
             self.end_ns = summary.statistics.message_end_time
+        elif summary.chunk_indexes:
+            self.start_ns = min(c.message_start_time for c in summary.chunk_indexes)
+            self.end_ns = max(c.message_end_time for c in summary.chunk_indexes)
 
     def messages(self, topics: set[str]) -> Iterator[tuple[str, int, bytes | memoryview]]:
         wanted = [t for t in topics if t in self.topics]
@@ -146,10 +168,76 @@ class McapSource(MessageSource):
             yield channel.topic, message.log_time, message.data
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
-        return self.store.deserialize_cdr(raw, msgtype)
+        try:
+            return self.store.deserialize_cdr(raw, msgtype)
+        except KeyError as err:
+            raise ValueError(f"message type {msgtype!r} has no definition") from err
 
     def close(self) -> None:
         self._handle.close()
+
+
+#: File signatures by suffix. rosbags reads a ROS1 bag's first line with an unbounded
+#: ``readline``: a zero-filled file was read whole (300 MB -> 700 MB of memory) before
+#: its magic was refused, so the first bytes are checked here first.
+_MAGICS = {".bag": b"#ROSBAG V2.0\n", ".db3": b"SQLite format 3\x00"}
+
+
+def check_magic(path: Path) -> None:
+    """ValueError unless a ``.bag``/``.db3`` file starts with its format's signature."""
+    magic = _MAGICS.get(path.suffix)
+    if magic is None:
+        return
+    with path.open("rb") as handle:
+        head = handle.read(len(magic))
+    if head != magic:
+        kind = "ROS1 bag v2.0" if path.suffix == ".bag" else "SQLite database"
+        raise ValueError(f"not a {kind} (the file does not start with {magic!r})")
+
+
+#: Magic (8 bytes) + footer record (opcode 1, length 8, summary_start 8,
+#: summary_offset_start 8, summary_crc 4) + magic: the smallest MCAP file.
+_MAGIC_SIZE = 8
+_FOOTER_SIZE = 1 + 8 + 8 + 8 + 4
+MIN_MCAP_BYTES = 2 * _MAGIC_SIZE + _FOOTER_SIZE
+
+
+def verify_summary_crc(handle: IO[bytes]) -> None:
+    """McapError unless the file is long enough and its summary section matches the footer CRC.
+
+    The CRC (when not 0) covers the summary section up to and including the footer's
+    ``summary_offset_start`` (MCAP specification, Footer); ``mcap.reader`` checks
+    only chunk CRCs, so a flipped byte in an index or the statistics went unnoticed.
+    """
+    size = handle.seek(0, 2)
+    if size < MIN_MCAP_BYTES:
+        raise McapError(f"file is {size} bytes, shorter than the smallest MCAP file")
+    footer_at = size - _MAGIC_SIZE - _FOOTER_SIZE
+    handle.seek(footer_at)
+    footer = handle.read(_FOOTER_SIZE)
+    opcode, length, summary_start, _, summary_crc = struct.unpack("<BQQQI", footer)
+    if opcode != 0x02 or length != 20:
+        raise McapError("no MCAP footer at the end of the file (truncated?)")
+    if summary_crc == 0 or summary_start == 0:
+        handle.seek(0)
+        return
+    if not 0 < summary_start <= footer_at:
+        raise McapError(f"footer points the summary to byte {summary_start}, outside the file")
+    handle.seek(summary_start)
+    crc = 0
+    remaining = footer_at + _FOOTER_SIZE - 4 - summary_start
+    while remaining > 0:
+        block = handle.read(min(remaining, 1 << 20))
+        if not block:
+            break
+        crc = zlib.crc32(block, crc)
+        remaining -= len(block)
+    handle.seek(0)
+    if crc != summary_crc:
+        raise McapError(
+            f"summary section CRC mismatch (footer {summary_crc:#010x}, computed {crc:#010x}): "
+            "the file is corrupt"
+        )
 
 
 @lru_cache(maxsize=8)

@@ -28,6 +28,26 @@ def slerp(q0: FloatArray, q1: FloatArray, t: float) -> FloatArray:
     return out
 
 
+#: A recorded quaternion's norm may differ from 1 by this much (float32 round trips, values
+#: rounded to two decimals; rotations are normalised on use); zero, or far from 1 (a flipped
+#: exponent bit), it is corrupt, not a rotation.
+QUATERNION_NORM_TOLERANCE = 0.1
+
+
+def pose_problem(pose: Pose) -> str | None:
+    """Why ``pose`` cannot be a recorded transform (None when it can)."""
+    t = np.asarray(pose.translation, dtype=np.float64)
+    q = np.asarray(pose.rotation, dtype=np.float64)
+    if not np.all(np.isfinite(t)):
+        return f"position {tuple(float(v) for v in t)} is not finite"
+    if not np.all(np.isfinite(q)):
+        return f"quaternion {tuple(float(v) for v in q)} is not finite"
+    norm = float(np.linalg.norm(q))
+    if abs(norm - 1.0) > QUATERNION_NORM_TOLERANCE:
+        return f"quaternion {tuple(float(v) for v in q)} has norm {norm:.6g}, not 1"
+    return None
+
+
 @dataclass
 class _Edge:
     parent: str
@@ -59,7 +79,13 @@ class TfBuffer:
         self._edges: dict[str, _Edge] = {}
 
     def add(self, parent: str, child: str, stamp_ns: int, pose: Pose, static: bool = False) -> None:
+        """Record ``parent_T_child`` at ``stamp_ns``; TransformLookupError on a non-finite pose."""
         parent, child = parent.lstrip("/"), child.lstrip("/")
+        problem = pose_problem(pose)
+        if problem is not None:
+            raise TransformLookupError(
+                f"{parent}->{child} at stamp {stamp_ns} ns ({stamp_ns / 1e9:.9f} s): {problem}"
+            )
         edge = self._edges.get(child)
         if edge is None:
             edge = self._edges[child] = _Edge(parent, static)

@@ -103,6 +103,8 @@ class RecordingWriter:
             raise ValueError(f"container={self.container!r} must be one of {', '.join(CONTAINERS)}")
         if self.path.exists() and not overwrite:
             raise FileExistsError(f"{self.path} exists; pass overwrite=True to replace it")
+        if self.path.is_dir() and not (self.path / "metadata.yaml").is_file():
+            raise IsADirectoryError(f"{self.path} is a folder, not a recording: not replaced")
         self.options = options or StreamOptions()
         self.ros_version: Literal[1, 2] = 1 if self.container == "ros1" else 2
         self.store = typestore(self.ros_version)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import math
 from typing import Literal
 
 from pydantic import Field, model_validator
@@ -15,6 +16,11 @@ class ClusterSelection(enum.Enum):
 
     HEIGHT = "height"
     CONFIDENCE = "confidence"
+
+
+#: Longest track-management duration accepted (about 11.6 days): beyond it the
+#: nanosecond stamps the tracker compares overflow (a tiny reference_rate_hz did).
+MAX_DURATION_S = 1e6
 
 
 class Basso2012TrackerConfig(ComponentConfig):
@@ -82,6 +88,19 @@ class Basso2012TrackerConfig(ComponentConfig):
             raise ValueError(
                 f"selectors={self.selectors} must not exceed weak_classifiers={self.weak_classifiers}"
             )
+        durations = {}
+        for name in ("frames_before_old", "frames_before_fake", "frames_remain_new"):
+            try:
+                durations[name] = self.seconds(getattr(self, name))
+            except OverflowError:  # a frame count beyond float range
+                durations[name] = math.inf
+        durations["classifier_memory_s"] = self.classifier_memory_s or 0.0
+        for name, seconds in durations.items():
+            if not seconds <= MAX_DURATION_S:  # also catches inf from a tiny reference_rate_hz
+                raise ValueError(
+                    f"{name} lasts {seconds:g} s at reference_rate_hz={self.reference_rate_hz:g}, "
+                    f"more than {MAX_DURATION_S:g} s"
+                )
         return self
 
     def seconds(self, frames: int) -> float:

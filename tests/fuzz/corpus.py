@@ -1,0 +1,579 @@
+"""A corpus of bad inputs, rebuilt in a temporary folder for each test.
+
+Each :class:`Case` names a failure class of issue 21 (TRACEBACK, SILENT, WRONG-CODE,
+HANG, MULTILINE, LEFTOVER), builds its inputs with the project's own writers (or by
+corrupting what they wrote), and states the documented exit code the CLI must give.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import struct
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from rgbd_eval.io.groundtruth import write_csv
+from rgbd_eval.io.writer import Container, RecordingWriter
+from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, GroundTruthObject, Pose
+from tests.io.conftest import (
+    BASE_TO_CAMERA,
+    DEPTH_CAM,
+    DEPTH_OFFSET,
+    PERIOD,
+    RGB_CAM,
+    T0,
+    Spec,
+    depth_image,
+    odom_pose,
+    rgb_image,
+    write_recording,
+)
+
+GT_HEADER = "frame,stamp_ns,id,bb_left,bb_top,bb_width,bb_height,x,y,z,visibility\n"
+FRAMES = 4
+
+
+@dataclass(frozen=True)
+class Case:
+    """One bad input: how to build it, the command line, the documented exit code."""
+
+    name: str
+    kind: str  # the failure class it reproduces
+    build: Callable[[Path], list[str]]  # writes inputs under the folder, returns CLI arguments
+    code: int
+    message: str = ""  # a fragment the one-line error must contain
+
+
+# ----------------------------------------------------------------------------- recordings
+
+
+def good_recording(root: Path, name: str = "rec.mcap", container: Container = "mcap") -> Path:
+    """A valid 4-frame recording (with its ground-truth topic)."""
+    path = root / name
+    if not path.exists():
+        write_recording(path, container, Spec(n=FRAMES))
+    return path
+
+
+def odd_recording(
+    path: Path,
+    container: Container = "ros1",
+    odom: Callable[[int], Pose] = odom_pose,
+    depth: Callable[[int], np.ndarray] = depth_image,
+    rgb_cam: CameraModel = RGB_CAM,
+    depth_cam: CameraModel = DEPTH_CAM,
+) -> Path:
+    """A 4-frame recording whose odometry, depth or image size is replaced."""
+    with RecordingWriter(path, container) as w:
+        w.write_static_transform(T0, "base_link", "camera_link", BASE_TO_CAMERA)
+        w.write_static_transform(T0, "camera_link", "camera_rgb_optical_frame", OPTICAL_TO_BODY)
+        w.write_static_transform(T0, "camera_link", "camera_depth_optical_frame", DEPTH_OFFSET)
+        for k in range(FRAMES * 2 + 4):
+            s = T0 - 20_000_000 + k * 20_000_000
+            w.write_odometry(s, "odom", "base_link", odom(s))
+        for i in range(FRAMES):
+            stamp = T0 + i * PERIOD
+            rgb = rgb_image(i)[: rgb_cam.height, : rgb_cam.width]
+            w.write_rgb(stamp, np.ascontiguousarray(rgb), rgb_cam)
+            w.write_depth(
+                stamp + 2_000_000, depth(i)[: depth_cam.height, : depth_cam.width], depth_cam
+            )
+    return path
+
+
+def flip_byte(path: Path, offset: int) -> None:
+    """Invert the bits of one byte of ``path``."""
+    with path.open("r+b") as handle:
+        handle.seek(offset)
+        value = handle.read(1)[0]
+        handle.seek(offset)
+        handle.write(bytes([value ^ 0xFF]))
+
+
+def mcap_chunk_data_offset(path: Path) -> int:
+    """Offset of the middle of the first chunk's compressed records (MCAP spec, Chunk)."""
+    data = path.read_bytes()
+    pos = 8  # magic
+    while pos < len(data):
+        opcode, length = struct.unpack_from("<BQ", data, pos)
+        if opcode == 0x06:  # Chunk: start 8, end 8, uncompressed size 8, crc 4, compression
+            body = pos + 9
+            clen = int(struct.unpack_from("<I", data, body + 28)[0])
+            records_at = body + 32 + clen + 8  # after compression string and records length
+            rlen = int(struct.unpack_from("<Q", data, body + 32 + clen)[0])
+            return records_at + rlen // 2
+        pos += 9 + length
+    raise ValueError("no chunk")
+
+
+def mcap_summary_offset(path: Path) -> int:
+    """Offset of a byte inside the summary section (from the footer)."""
+    data = path.read_bytes()
+    footer = len(data) - 8 - 29
+    summary_start = int(struct.unpack_from("<Q", data, footer + 9)[0])
+    return summary_start + 20
+
+
+def without_statistics(source: Path, target: Path) -> Path:
+    """``source`` rewritten with the same records but no Statistics record in its summary."""
+    from mcap.reader import make_reader
+    from mcap.writer import CompressionType, Writer
+
+    with source.open("rb") as fin, target.open("wb") as fout:
+        reader = make_reader(fin)
+        writer = Writer(fout, compression=CompressionType.ZSTD, use_statistics=False)
+        writer.start(profile="ros2", library="test")
+        schemas: dict[int, int] = {}
+        channels: dict[int, int] = {}
+        for schema, channel, message in reader.iter_messages():
+            if schema is not None and schema.id not in schemas:
+                schemas[schema.id] = writer.register_schema(
+                    schema.name, schema.encoding, schema.data
+                )
+            if channel.id not in channels:
+                channels[channel.id] = writer.register_channel(
+                    channel.topic, channel.message_encoding, schemas.get(channel.schema_id, 0)
+                )
+            writer.add_message(
+                channels[channel.id], message.log_time, message.data, message.publish_time
+            )
+        writer.finish()
+    return target
+
+
+def _nan_quat(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    return Pose(p.translation, (0.0, 0.0, float("nan"), 1.0)) if stamp > T0 else p
+
+
+def _zero_quat(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    return Pose(p.translation, (0.0, 0.0, 0.0, 0.0)) if stamp > T0 else p
+
+
+def _inf_pos(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    return Pose((float("inf"), 0.0, 0.0), p.rotation) if stamp > T0 else p
+
+
+def _all_nan_depth(i: int) -> np.ndarray:
+    return np.full((DEPTH_CAM.height, DEPTH_CAM.width), np.nan, dtype=np.float32)
+
+
+def _all_zero_depth(i: int) -> np.ndarray:
+    return np.zeros((DEPTH_CAM.height, DEPTH_CAM.width), dtype=np.float32)
+
+
+def _recording_cases() -> list[Case]:
+    def flipped_chunk(root: Path) -> list[str]:
+        rec = root / "flip_chunk.mcap"
+        write_recording(rec, "mcap", Spec(n=FRAMES))
+        flip_byte(rec, mcap_chunk_data_offset(rec))
+        return ["run", str(rec), "--out", str(root / "out")]
+
+    def flipped_summary(root: Path) -> list[str]:
+        rec = root / "flip_summary.mcap"
+        write_recording(rec, "mcap", Spec(n=FRAMES))
+        flip_byte(rec, mcap_summary_offset(rec))
+        return ["run", str(rec), "--out", str(root / "out")]
+
+    def empty_mcap(root: Path) -> list[str]:
+        (root / "empty.mcap").write_bytes(b"")
+        return ["run", str(root / "empty.mcap"), "--out", str(root / "out")]
+
+    def fifo(suffix: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            os.mkfifo(root / f"pipe{suffix}")
+            return ["inspect", str(root / f"pipe{suffix}")]
+
+        return build
+
+    def devzero(root: Path) -> list[str]:
+        (root / "zero.bag").symlink_to("/dev/zero")
+        return ["inspect", str(root / "zero.bag")]
+
+    def zero_filled(root: Path) -> list[str]:
+        with (root / "zeros.bag").open("wb") as handle:  # sparse: 300 MB of zeros, no disk
+            handle.truncate(300 << 20)
+        return ["run", str(root / "zeros.bag"), "--out", str(root / "out")]
+
+    def odd(name: str, **kwargs: object) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            rec = odd_recording(root / f"{name}.bag", **kwargs)  # type: ignore[arg-type]
+            return ["run", str(rec), "--out", str(root / "out")]
+
+        return build
+
+    tiny = CameraModel(1, 1, 1.0, 1.0, 0.0, 0.0, (0.0,) * 5, "camera_rgb_optical_frame")
+    tiny_depth = CameraModel(1, 1, 1.0, 1.0, 0.0, 0.0, (0.0,) * 5, "camera_depth_optical_frame")
+    return [
+        Case("flip_chunk_mcap", "SILENT", flipped_chunk, 3, "crc"),
+        Case("flip_summary_mcap", "SILENT", flipped_summary, 3, "summary section CRC"),
+        Case("empty_mcap", "MISLEADING", empty_mcap, 3, "0 bytes"),
+        Case("fifo_mcap", "HANG", fifo(".mcap"), 3, "named pipe"),
+        Case("fifo_bag", "HANG", fifo(".bag"), 3, "named pipe"),
+        Case("devzero_bag", "HANG", devzero, 3, "device"),
+        Case("zero_filled_bag", "HANG", zero_filled, 3, "not a ROS1 bag"),
+        Case("odom_nan_quat", "SILENT", odd("odom_nan_quat", odom=_nan_quat), 3, "/odom"),
+        Case("odom_zero_quat", "TRACEBACK", odd("odom_zero_quat", odom=_zero_quat), 3, "norm 0"),
+        Case("odom_inf_pos", "SILENT", odd("odom_inf_pos", odom=_inf_pos), 3, "not finite"),
+        Case("depth_all_nan", "SILENT", odd("depth_nan", depth=_all_nan_depth), 3, "no depth"),
+        Case("depth_all_zero", "SILENT", odd("depth_zero", depth=_all_zero_depth), 3, "no depth"),
+        Case(
+            "image_1x1",
+            "SILENT",
+            odd("img_1x1", rgb_cam=tiny, depth_cam=tiny_depth),
+            3,
+            "smaller than",
+        ),
+    ]
+
+
+# ----------------------------------------------------------------------------- ground truth
+
+
+def _gt_case(name: str, text: bytes, code: int, message: str, suffix: str = ".csv") -> Case:
+    def build(root: Path) -> list[str]:
+        gt = root / f"{name}{suffix}"
+        gt.write_bytes(text)
+        return ["run", str(good_recording(root)), "--gt", str(gt), "--out", str(root / "out")]
+
+    return Case(f"gt_{name}", "GROUND-TRUTH", build, code, message)
+
+
+def _gt_cases() -> list[Case]:
+    row = "0,0,1,10,5,8,30,2.0,0.1,0.9,1\n"
+    stamp = T0 / 1e9
+
+    def fifo(root: Path) -> list[str]:
+        os.mkfifo(root / "pipe.csv")
+        return ["run", str(good_recording(root)), "--gt", str(root / "pipe.csv")]
+
+    return [
+        Case("gt_fifo", "HANG", fifo, 5, "named pipe"),
+        _gt_case("short_row", (GT_HEADER + "0,0,1,10\n").encode(), 5, "fewer fields"),
+        _gt_case("long_row", (GT_HEADER + row.strip() + ",1,2,3\n").encode(), 5, "more fields"),
+        _gt_case("latin1", (GT_HEADER + "# caf\xe9\n").encode("latin-1"), 5, "not UTF-8"),
+        _gt_case("binary", bytes(range(256)) * 4, 5, "not UTF-8"),
+        _gt_case("nan_box", (GT_HEADER + "0,0,1,10,5,nan,30,,,,1\n").encode(), 5, "finite"),
+        _gt_case("inf_box", (GT_HEADER + "0,0,1,10,5,inf,30,,,,1\n").encode(), 5, "finite"),
+        _gt_case("inf_xyz", (GT_HEADER + "0,0,1,10,5,8,30,inf,0.1,0.9,1\n").encode(), 5, "finite"),
+        _gt_case("part_box", (GT_HEADER + "0,0,1,10,,8,30,,,,1\n").encode(), 5, "partly"),
+        _gt_case("huge_id", (GT_HEADER + f"0,0,{2**60},10,5,8,30,,,,1\n").encode(), 5, "2**53"),
+        _gt_case("header_only", GT_HEADER.encode(), 5, "no annotated object"),
+        _gt_case("ktp_nan", f"nan: 1 10 5 8 30\n{stamp}: 1 1 1 1 1\n".encode(), 5, "stamp", ".txt"),
+        _gt_case("ktp_inf_value", f"{stamp}: 1 10 5 inf 30\n".encode(), 5, "not finite", ".txt"),
+        _gt_case("ktp_neg_box", f"{stamp}: 1 10 10 -50 -100\n".encode(), 5, "negative", ".txt"),
+    ]
+
+
+# ----------------------------------------------------------------------------- configs
+
+
+def _cfg_case(name: str, text: bytes, code: int, message: str) -> Case:
+    def build(root: Path) -> list[str]:
+        cfg = root / f"{name}.yaml"
+        cfg.write_bytes(text)
+        rec = good_recording(root)
+        return ["run", str(rec), "--config", str(cfg), "--out", str(root / "out")]
+
+    return Case(f"cfg_{name}", "CONFIG", build, code, message)
+
+
+def _set_case(name: str, sets: list[str], code: int, message: str, kind: str = "TRACEBACK") -> Case:
+    def build(root: Path) -> list[str]:
+        extra = [a for s in sets for a in ("--set", s)]
+        return ["run", str(good_recording(root)), *extra, "--out", str(root / "out")]
+
+    return Case(f"set_{name}", kind, build, code, message)
+
+
+_BOMB = "a: &a [x, x, x, x, x, x, x, x, x]\n" + "".join(
+    f"{c}: &{c} [*{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}, *{p}]\n"
+    for p, c in zip("abcdefgh", "bcdefghi", strict=True)
+)
+
+
+def _config_cases() -> list[Case]:
+    def fifo(root: Path) -> list[str]:
+        os.mkfifo(root / "pipe.yaml")
+        return ["run", str(good_recording(root)), "--config", str(root / "pipe.yaml")]
+
+    return [
+        _cfg_case(
+            "dup_keys", b"tracker:\n  min_confidence: -1\n  min_confidence: 0\n", 4, "duplicate"
+        ),
+        _cfg_case("latin1", "tracker: {min_confidence: caf\xe9}\n".encode("latin-1"), 4, "UTF-8"),
+        _cfg_case("nan", b"tracker:\n  min_confidence: .nan\n", 4, "finite"),
+        _cfg_case("bom", b"\xef\xbb\xbftracker:\n  min_confidence: 0\n", 0, ""),
+        _cfg_case("alias_bomb", _BOMB.encode(), 4, "aliases"),
+        Case("cfg_fifo", "HANG", fifo, 4, "named pipe"),
+        _set_case("nan_minconf", ["tracker.min_confidence=.nan"], 4, "--set"),
+        _set_case("inf_maxdist", ["detector.max_distance=.inf"], 4, "finite"),
+        _set_case("rate_tiny", ["tracker.reference_rate_hz=1e-300"], 4, "reference_rate_hz"),
+        _set_case(
+            "plane_zero",
+            ["detector.ground_mode=plane", "detector.ground_plane=[0,0,0,0]"],
+            4,
+            "normal",
+        ),
+        _set_case(
+            "points_collinear",
+            ["detector.ground_mode=points", "detector.ground_points=[[0,0,1],[0,0,2],[0,0,3]]"],
+            4,
+            "collinear",
+        ),
+        _set_case(
+            "pixels_outside",
+            ["detector.ground_mode=points", "detector.ground_pixels=[[1,1],[99999,0],[0,2]]"],
+            4,
+            "off the",
+            "SILENT",
+        ),
+        _set_case(
+            "threshold_inf", ["evaluation.gating=metric", "evaluation.threshold=.inf"], 4, ""
+        ),
+    ]
+
+
+# ----------------------------------------------------------------------------- usage
+
+
+def _usage_cases() -> list[Case]:
+    def args(*a: str) -> Callable[[Path], list[str]]:
+        return lambda root: list(a)
+
+    return [
+        Case("usage_bad_number", "MULTILINE", args("run", "--threshold", "abc"), 2, "--threshold"),
+        Case("usage_unknown_option", "MULTILINE", args("run", "--bogus"), 2, "--bogus"),
+        Case("usage_no_command", "MULTILINE", args(), 2, "no command"),
+        Case("usage_bad_command", "MULTILINE", args("frobnicate"), 2, "frobnicate"),
+    ]
+
+
+# ----------------------------------------------------------------------------- outputs
+
+
+def _output_cases() -> list[Case]:
+    def out_is_file(root: Path) -> list[str]:
+        (root / "file.txt").write_text("mine\n")
+        return ["run", str(good_recording(root)), "--out", str(root / "file.txt")]
+
+    def out_parent_is_file(root: Path) -> list[str]:
+        (root / "afile").write_text("mine\n")
+        return ["run", str(good_recording(root)), "--out", str(root / "afile" / "sub")]
+
+    def out_proc(root: Path) -> list[str]:
+        return ["run", str(good_recording(root)), "--out", "/proc/rgbd_eval_out"]
+
+    def foreign(root: Path) -> list[str]:
+        (root / "out").mkdir()
+        (root / "out" / "notes.txt").write_text("mine\n")
+        return ["run", str(good_recording(root)), "--out", str(root / "out")]
+
+    def synth_into_folder(root: Path) -> list[str]:
+        (root / "data").mkdir()
+        (root / "data" / "notes.txt").write_text("mine\n")
+        return ["synth", "demo", "--frames", "1", "-o", str(root / "data")]
+
+    def preview_bad_dir(root: Path) -> list[str]:
+        (root / "afile").write_text("mine\n")
+        return ["synth", "demo", "--frames", "1", "--preview", str(root / "afile" / "p.png")]
+
+    return [
+        Case("out_is_file", "TRACEBACK", out_is_file, 7, "not a folder"),
+        Case("out_parent_is_file", "TRACEBACK", out_parent_is_file, 7, "cannot create"),
+        Case("out_proc", "TRACEBACK", out_proc, 7, ""),
+        Case("out_foreign_folder", "DATA-LOSS", foreign, 7, "--force"),
+        Case("synth_into_folder", "DATA-LOSS", synth_into_folder, 7, "folder"),
+        Case("synth_preview_bad_dir", "TRACEBACK", preview_bad_dir, 7, ""),
+    ]
+
+
+# ----------------------------------------------------------------------------- compare
+
+
+def report(
+    metrics: Mapping[str, object] | None, name: str = "rec", **extra: object
+) -> dict[str, object]:
+    """A minimal valid report with one sequence."""
+    data: dict[str, object] = {
+        "schema_version": 1,
+        "evaluation": {"gating": "iou", "threshold": 0.5},
+        "config": {},
+        "sequences": [{"name": name, "sha256": "0" * 64, "metrics": metrics}],
+        "overall": None,
+    }
+    data.update(extra)
+    return data
+
+
+BASE_METRICS = {"mota": 0.7, "motp": 0.8, "idf1": 0.75, "fp_rate": 0.1, "fn_rate": 0.2}
+
+
+def _cmp_case(
+    name: str,
+    current: object,
+    code: int,
+    message: str,
+    raw: bytes | None = None,
+    extra: tuple[str, ...] = (),
+) -> Case:
+    def build(root: Path) -> list[str]:
+        (root / "base.json").write_text(json.dumps(report(BASE_METRICS)))
+        cur = root / f"{name}.json"
+        cur.write_bytes(raw if raw is not None else json.dumps(current).encode())
+        return ["compare", str(root / "base.json"), str(cur), *extra]
+
+    return Case(f"cmp_{name}", "COMPARE", build, code, message)
+
+
+def _compare_cases() -> list[Case]:
+    seq_str = report(BASE_METRICS)
+    seq_str["sequences"] = ["rec"]
+    no_name = report(BASE_METRICS)
+    no_name["sequences"] = [{"metrics": BASE_METRICS}]
+    no_eval = report(BASE_METRICS)
+    del no_eval["evaluation"]
+    lower = dict(BASE_METRICS, mota=0.5)
+
+    def markdown_dir(root: Path) -> list[str]:
+        (root / "base.json").write_text(json.dumps(report(BASE_METRICS)))
+        (root / "md").mkdir()
+        return [
+            "compare",
+            str(root / "base.json"),
+            str(root / "base.json"),
+            "--markdown",
+            str(root / "md"),
+        ]
+
+    return [
+        _cmp_case("schema_only", {"schema_version": 1}, 2, "evaluation"),
+        _cmp_case("metrics_str", report({**BASE_METRICS, "mota": "high"}), 2, "not a number"),
+        _cmp_case("no_name", no_name, 2, "name"),
+        _cmp_case("seq_str", seq_str, 2, "name"),
+        _cmp_case("no_eval", no_eval, 2, "evaluation"),
+        _cmp_case(
+            "nan",
+            None,
+            2,
+            "NaN",
+            raw=json.dumps(report(BASE_METRICS)).replace("0.7", "NaN").encode(),
+        ),
+        _cmp_case(
+            "latin1", None, 2, "UTF-8", raw=json.dumps(report(BASE_METRICS)).encode() + b"\xe9"
+        ),
+        _cmp_case("unscored_current", report(None), 1, "missing now"),
+        _cmp_case("mota_null", report({**BASE_METRICS, "mota": None}), 1, "rec/mota"),
+        _cmp_case("metrics_empty", report({}), 1, "missing now"),
+        _cmp_case("regressed", report(lower), 1, "1 regression(s) beyond tolerance: rec/mota"),
+        _cmp_case("tolerance_nan", report(lower), 2, "finite", extra=("--tolerance", "mota=nan")),
+        Case("cmp_markdown_dir", "TRACEBACK", markdown_dir, 7, "folder"),
+    ]
+
+
+def _other_command_cases() -> list[Case]:
+    def with_bad_sidecar(root: Path) -> Path:
+        rec = good_recording(root)
+        (root / "rec.gt.csv").write_text(GT_HEADER + "0,0,1,10\n")  # a short row
+        return rec
+
+    def run_sidecar(root: Path) -> list[str]:
+        return ["run", str(with_bad_sidecar(root)), "--out", str(root / "out")]
+
+    def sweep_sidecar(root: Path) -> list[str]:
+        rec = with_bad_sidecar(root)
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            "0",
+            "--dataset",
+            str(rec),
+            "--jobs",
+            "2",
+            "--out",
+            str(root / "out"),
+        ]
+
+    def sweep_corrupt(root: Path) -> list[str]:
+        rec = root / "flip.mcap"
+        write_recording(rec, "mcap", Spec(n=FRAMES))
+        flip_byte(rec, mcap_chunk_data_offset(rec))
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            "0",
+            "--dataset",
+            str(rec),
+            "--jobs",
+            "2",
+            "--out",
+            str(root / "out"),
+        ]
+
+    def sweep_nan(root: Path) -> list[str]:
+        rec = good_recording(root)
+        return [
+            "sweep",
+            "tracker.min_confidence",
+            "-1",
+            ".nan",
+            "--dataset",
+            str(rec),
+            "--out",
+            str(root / "out"),
+        ]
+
+    def inspect_bad_gt(root: Path) -> list[str]:
+        (root / "short.csv").write_text(GT_HEADER + "0,0,1,10\n")
+        return ["inspect", str(good_recording(root)), "--gt", str(root / "short.csv")]
+
+    def zero_quat(command: str, *extra: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            rec = odd_recording(root / "zq.bag", odom=_zero_quat)
+            return [command, str(rec), *extra]
+
+        return build
+
+    return [
+        Case("run_sidecar_short_row", "TRACEBACK", run_sidecar, 5, "fewer fields"),
+        Case("sweep_sidecar_short_row", "TRACEBACK", sweep_sidecar, 5, "fewer fields"),
+        Case("sweep_nan_value", "TRACEBACK", sweep_nan, 4, "finite"),
+        Case("sweep_corrupt_in_worker", "SILENT", sweep_corrupt, 3, "crc"),
+        Case("inspect_bad_gt", "TRACEBACK", inspect_bad_gt, 5, "fewer fields"),
+        Case("inspect_json_zero_quat", "TRACEBACK", zero_quat("inspect", "--json"), 3, "norm 0"),
+        Case("bench_zero_quat", "TRACEBACK", zero_quat("bench", "--repeat", "1"), 3, "norm 0"),
+    ]
+
+
+def all_cases() -> list[Case]:
+    """Every case of the corpus."""
+    return [
+        *_recording_cases(),
+        *_gt_cases(),
+        *_config_cases(),
+        *_usage_cases(),
+        *_output_cases(),
+        *_compare_cases(),
+        *_other_command_cases(),
+    ]
+
+
+def ground_truth_objects(n: int = FRAMES) -> list[GroundTruthObject]:
+    """One person per frame with box and world position (for scored runs)."""
+    return [
+        GroundTruthObject(
+            i, T0 + i * PERIOD, 7, Box2D(10.0 + i, 5.0, 8.0, 30.0), (2.0, 0.1 * i, 0.9)
+        )
+        for i in range(n)
+    ]
+
+
+__all__ = ["Case", "all_cases", "flip_byte", "good_recording", "ground_truth_objects", "write_csv"]
