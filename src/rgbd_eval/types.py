@@ -358,6 +358,8 @@ class Detection:
     ``position`` is the theoretical centroid (x, y, z) in the world frame; its x, y
     are the ground-plane position used by trackers and metric gating.
     ``appearance`` is a method-specific descriptor (e.g. a 3D colour histogram).
+    ``footprint`` is the world (x, y) of the floor cells of a density-map blob, ``(N, 2)``
+    (seed 003's blob splitting divides it among the tracks that share it).
     """
 
     position: tuple[float, float, float]
@@ -368,6 +370,7 @@ class Detection:
     distance: float = 0.0
     occluded: bool = False
     appearance: NDArray[np.float32] | None = None
+    footprint: NDArray[np.float64] | None = None
 
     @property
     def ground_xy(self) -> tuple[float, float]:

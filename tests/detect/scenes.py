@@ -218,3 +218,16 @@ def _cast_rgb(
     img[(ids == floor_id) & tiles] *= 0.8
     img[miss] = 0.0
     return np.clip(img, 0, 255).astype(np.uint8)
+
+
+def ring_texture(width: int = 640, height: int = 480) -> NDArray[np.uint8]:
+    """Concentric colour rings in integer arithmetic: edges of every orientation and spacing.
+
+    Exactly reproducible anywhere (no floating point), so tests can rebuild it
+    instead of storing it; channel ``c`` has rings about its own centre.
+    """
+    y, x = np.mgrid[0:height, 0:width].astype(np.int64)
+    out = np.empty((height, width, 3), dtype=np.uint8)
+    for c, (cx, cy, k) in enumerate(((150, 130, 37), (470, 300, 53), (330, 520, 71))):
+        out[..., c] = (((x - cx) ** 2 + (y - cy) ** 2) // k * 7 % 256).astype(np.uint8)
+    return out

@@ -15,7 +15,7 @@ from rgbd_eval.config import build_config
 from rgbd_eval.detect import create_detector
 from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
 from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
-from rgbd_eval.detect.basso2012_config import GroundMode
+from rgbd_eval.detect.basso2012_config import GroundMode, HogBorder, HogClassifier
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.plugins import known
 from rgbd_eval.types import OPTICAL_TO_BODY, Detection, Frame
@@ -150,15 +150,20 @@ def test_pair_in_a_corridor_under_a_ceiling() -> None:
 
 def test_person_behind_an_obstacle_is_kept_and_flagged_occluded() -> None:
     # A 1 m tall box 0.8 m in front hides the legs: occluded, still detected, and not
-    # visible top to bottom, so the thesis' default confidence -100 (5.4.2).
+    # visible top to bottom: with hog_border 'skip' the thesis' default confidence -100
+    # (5.4.2); with 'pad' (the default) the window, legs hidden by the box, is scored.
     person = Person(4.0, 0.0, 1.75)
     scene = Scene(people=[person], blocks=[Block(3.2, 0.0, (0.5, 1.0, 1.0))])
-    dets = _detect(render(scene, camera_pose(height=1.0)))
+    frame = render(scene, camera_pose(height=1.0))
+    dets = _detect(frame, DetectorConfig(hog_border=HogBorder.SKIP))
     assert len(dets) == 1  # the 1 m box is below min_height 1.4
     d = dets[0]
     assert d.occluded
     assert d.confidence == -100.0
     _assert_person(d, person)
+    padded = _detect(frame)[0]
+    assert padded.occluded and -10.0 < padded.confidence < 10.0
+    assert padded.position == d.position
 
 
 def test_person_partly_hidden_by_another_is_flagged_occluded() -> None:
@@ -215,10 +220,33 @@ def test_tilted_sensor_without_odometry_finds_the_floor() -> None:
 
 def test_person_cut_by_the_image_top_is_flagged_and_not_hog_scored() -> None:
     # Pitched down 15 degrees from 1.2 m: the top of the view at 3 m is at 1.54 m.
-    dets = _detect(render(Scene(people=[Person(3.0, 0.2)]), camera_pose(height=1.2, pitch_deg=15)))
+    # hog_border 'skip' (the thesis): not visible top to bottom, not scored.
+    frame = render(Scene(people=[Person(3.0, 0.2)]), camera_pose(height=1.2, pitch_deg=15))
+    dets = _detect(frame, DetectorConfig(hog_border=HogBorder.SKIP))
     assert len(dets) == 1
     assert dets[0].occluded
     assert dets[0].confidence == -100.0
+
+
+@pytest.mark.parametrize("hog", [HogClassifier.AUTHORS, HogClassifier.OPENCV])
+def test_pad_scores_the_person_cut_by_the_image_top(hog: HogClassifier) -> None:
+    # As above; with hog_border 'pad' the window's part above the image is black and
+    # the cluster gets a real confidence (the authors' later behaviour), still flagged.
+    frame = render(Scene(people=[Person(3.0, 0.2)]), camera_pose(height=1.2, pitch_deg=15))
+    skip = _detect(frame, DetectorConfig(hog=hog, hog_border=HogBorder.SKIP))
+    pad = _detect(frame, DetectorConfig(hog=hog))  # the default
+    assert skip[0].confidence == -100.0
+    assert len(pad) == 1 and pad[0].occluded
+    assert -10.0 < pad[0].confidence < 10.0
+
+
+def test_classifiers_give_different_scales_on_the_same_person() -> None:
+    frame = render(Scene(people=[Person(3.5, 0.0, 1.75)]), camera_pose(height=1.0))
+    authors = _detect(frame, DetectorConfig(hog=HogClassifier.AUTHORS))[0]
+    opencv = _detect(frame, DetectorConfig(hog=HogClassifier.OPENCV))[0]
+    # Same cluster, same geometry; only the confidence differs.
+    assert authors.position == opencv.position and authors.box2d == opencv.box2d
+    assert authors.confidence != opencv.confidence
 
 
 @pytest.mark.parametrize("odometry", [True, False])

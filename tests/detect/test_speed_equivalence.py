@@ -37,7 +37,7 @@ from rgbd_eval.detect.clustering import (
     merge_close_clusters,
     split_by_heads,
 )
-from rgbd_eval.detect.features import blob, colour_histogram
+from rgbd_eval.detect.features import blob, colour_histogram, touches_border
 from rgbd_eval.detect.plane import cross3
 from rgbd_eval.types import CameraModel
 
@@ -544,3 +544,23 @@ def test_stable_argsort_is_numpys(seed: int, n: int, key_count: int) -> None:
     for dtype in (np.int64, np.int32) if key_count <= 2**31 else (np.int64,):
         k = keys.astype(dtype)
         assert np.array_equal(stable_argsort(k, key_count), np.argsort(k, kind="stable"))
+
+
+def reference_touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
+    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
+    if pixels.shape[0] == 0:
+        return (False, False, False)
+    rows, cols = np.divmod(pixels, camera.width)
+    return (
+        bool(rows.min() == 0),
+        bool(rows.max() == camera.height - 1),
+        bool(cols.min() == 0 or cols.max() == camera.width - 1),
+    )
+
+
+@settings(max_examples=150, deadline=None)
+@given(SEEDS, st.integers(0, 50), st.integers(1, 12), st.integers(1, 16))
+def test_touches_border_matches_reference(seed: int, n: int, rows: int, cols: int) -> None:
+    camera = CameraModel(cols, rows, 10.0, 10.0, cols / 2, rows / 2)
+    pixels = np.random.default_rng(seed).integers(0, rows * cols, n)
+    assert touches_border(pixels, camera) == reference_touches_border(pixels, camera)

@@ -22,7 +22,13 @@ import time
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig, GroundMode
+from rgbd_eval.detect.authors_hog import PersonWindow, person_confidences
+from rgbd_eval.detect.basso2012_config import (
+    Basso2012DetectorConfig,
+    GroundMode,
+    HogBorder,
+    HogClassifier,
+)
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -48,6 +54,7 @@ from rgbd_eval.detect.features import (
     full_body_box,
     occluded_by_nearer_points,
     project_to_rgb,
+    touches_border,
 )
 from rgbd_eval.detect.ground import GroundPlaneEstimator
 from rgbd_eval.detect.hog import hog_confidences
@@ -83,6 +90,7 @@ class _Candidate:
         box3d: Box3D,
         occluded: bool,
         hog_eligible: bool,
+        window: PersonWindow,
         appearance: NDArray[np.float32],
     ) -> None:
         self.geometry = geometry
@@ -90,6 +98,7 @@ class _Candidate:
         self.box3d = box3d
         self.occluded = occluded
         self.hog_eligible = hog_eligible
+        self.window = window
         self.appearance = appearance
 
 
@@ -129,16 +138,25 @@ class Basso2012Detector:
                 return []
             candidates = self._candidates(frame, plane, cloud, grid, clock)
             confidences = np.full(len(candidates), cfg.hog_default_confidence)
-            eligible = [i for i, c in enumerate(candidates) if c.hog_eligible]
+            eligible = [
+                i
+                for i, c in enumerate(candidates)
+                if c.hog_eligible or cfg.hog_border is HogBorder.PAD
+            ]
             if eligible:
-                scores = hog_confidences(frame.rgb, [candidates[i].box for i in eligible])
-                confidences[eligible] = scores
+                confidences[eligible] = self._classify(frame, [candidates[i] for i in eligible])
             clock.lap("hog")
             return self._detections(frame, candidates, confidences)
         finally:
             self.last_timings = clock.timings
 
     # ------------------------------------------------------------------ stages
+
+    def _classify(self, frame: Frame, candidates: list[_Candidate]) -> FloatArray:
+        """Person-classifier confidences of ``candidates`` (``detector.hog``)."""
+        if self.config.hog is HogClassifier.OPENCV:
+            return hog_confidences(frame.rgb, [c.box for c in candidates])
+        return person_confidences(frame.rgb, [c.window for c in candidates])
 
     def _rays_for(self, camera: CameraModel) -> FloatArray:
         rays = self._rays.get(camera)
@@ -254,10 +272,12 @@ class Basso2012Detector:
             point_label[labelled], signed_heights(np.take(cloud.points, labelled, axis=0), plane), k
         )[1]
         in_range = np.flatnonzero((tops >= cfg.min_height) & (tops <= cfg.max_height))
+        # Each cluster's full-resolution points, gathered once for geometry and blob.
+        full = {c: np.take(cloud.points, members(c), axis=0) for c in in_range.tolist()}
         geometries = {
             c: cluster_geometry(
                 np.take(pts, voxels(c), axis=0),
-                np.take(cloud.points, members(c), axis=0),
+                full[c],
                 plane,
                 cfg.head_centroid,
                 cfg.surface_correction,
@@ -273,7 +293,7 @@ class Basso2012Detector:
             box = full_body_box(g, np.take(uv, mine, axis=0), project)
             if box is None:
                 continue
-            cut_top, cut_bottom, cut_side = _touches_border(
+            cut_top, cut_bottom, cut_side = touches_border(
                 cloud.pixels[members(c)], frame.depth_camera
             )
             in_view = box_inside_image(box, frame.rgb_camera) and not (
@@ -295,13 +315,17 @@ class Basso2012Detector:
                 and box.bottom <= frame.rgb_camera.height - 0.5
                 and 0.0 <= centre_u < frame.rgb_camera.width
             )
-            blob_uv, _ = project(np.take(cloud.points, members(c), axis=0))
+            # The authors' window (PCL): as tall as the head-to-ground projection,
+            # centred on the projected mid point of the person's axis.
+            mid_uv, _ = project(g.theoretical_centroid[None, :])
+            window = PersonWindow(box.height, float(mid_uv[0, 0]), float(mid_uv[0, 1]))
+            blob_uv, _ = project(full[c])
             appearance = colour_histogram(
                 frame.rgb, blob(blob_uv, footprint, frame.rgb_camera), cfg.histogram_bins
             )
             box3d = _world_box(frame, np.vstack([np.take(pts, mine, axis=0), g.ground_point]))
             candidates.append(
-                (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, appearance))
+                (g.distance, _Candidate(g, box, box3d, occluded, hog_eligible, window, appearance))
             )
         return [c for _, c in candidates]
 
@@ -334,18 +358,6 @@ class Basso2012Detector:
 def _footprint(frame: Frame) -> int:
     """RGB pixels per depth pixel (per side), at least 1."""
     return max(1, round(frame.rgb_camera.fx / frame.depth_camera.fx))
-
-
-def _touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
-    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
-    if pixels.shape[0] == 0:
-        return (False, False, False)
-    rows, cols = np.divmod(pixels, camera.width)
-    return (
-        bool(rows.min() == 0),
-        bool(rows.max() == camera.height - 1),
-        bool(cols.min() == 0 or cols.max() == camera.width - 1),
-    )
 
 
 def _world_box(frame: Frame, points: FloatArray) -> Box3D:

@@ -20,6 +20,20 @@ class GroundMode(enum.Enum):
     PLANE = "plane"
 
 
+class HogClassifier(enum.Enum):
+    """Which person classifier scores the clusters (seed 000, 5.4.2)."""
+
+    AUTHORS = "authors"  # Dollár's HOG + the authors' SVM: the thesis' confidence units
+    OPENCV = "opencv"  # OpenCV's Dalal-Triggs INRIA people detector: another scale
+
+
+class HogBorder(enum.Enum):
+    """Clusters whose person window is not wholly visible (seed 000, 5.4.2)."""
+
+    SKIP = "skip"  # the thesis: not scored, hog_default_confidence (-100)
+    PAD = "pad"  # the authors' later code (PCL): scored, the window's outside black
+
+
 class Basso2012DetectorConfig(ComponentConfig):
     """The basso2012 detector (seed 000, chapter 5; defaults from Table 5.1, voxel 0.06 m)."""
 
@@ -90,6 +104,18 @@ class Basso2012DetectorConfig(ComponentConfig):
         description="move the head centroid from the visible surface to the head's axis "
         "(4/3 of the across-view spread, exact for a sphere or upright cylinder); off = the "
         "surface mean of 5.3",
+    )
+    hog: HogClassifier = Field(
+        HogClassifier.AUTHORS,
+        description="person classifier: 'authors' (Dollár's HOG and the thesis authors' SVM, "
+        "the units of the thesis' confidence thresholds) or 'opencv' (INRIA people detector)",
+    )
+    hog_border: HogBorder = Field(
+        HogBorder.PAD,
+        description="'pad' (default): every cluster is scored, the window's outside the image "
+        "black (the authors' later PCL code), so people cut by the image or whose feet are "
+        "hidden can start tracks; 'skip': clusters not visible top to bottom get "
+        "hog_default_confidence (the thesis, 5.4.2; what `reproduce basso2012` uses)",
     )
     hog_max_ground_gap: float = Field(
         0.3,

@@ -262,3 +262,28 @@ def colour_histogram(rgb: NDArray[np.uint8], region: Blob, bins: int) -> NDArray
     hist = np.asarray(counts, dtype=np.float64).reshape(-1)
     out: NDArray[np.float32] = (hist / hist.sum()).astype(np.float32)
     return out
+
+
+def _pixel_extent(pixels: IntArray, width: int) -> tuple[int, int, int, int]:
+    """Smallest and largest row and column of flat (row-major) pixel indices."""
+    r_lo, r_hi, c_lo, c_hi = 2**62, -(2**62), 2**62, -(2**62)
+    for p in pixels:
+        r, c = p // width, p % width
+        r_lo, r_hi = min(r_lo, r), max(r_hi, r)
+        c_lo, c_hi = min(c_lo, c), max(c_hi, c)
+    return r_lo, r_hi, c_lo, c_hi
+
+
+_extent_kernel: Callable[[IntArray, int], tuple[int, int, int, int]] = numba.njit(cache=True)(
+    _pixel_extent
+)
+
+
+def touches_border(pixels: IntArray, camera: CameraModel) -> tuple[bool, bool, bool]:
+    """Whether a cluster's depth pixels reach the image's top, bottom, or left/right edge."""
+    if pixels.shape[0] == 0:
+        return (False, False, False)
+    r_lo, r_hi, c_lo, c_hi = _extent_kernel(
+        np.ascontiguousarray(pixels, dtype=np.int64), camera.width
+    )
+    return (r_lo == 0, r_hi == camera.height - 1, c_lo == 0 or c_hi == camera.width - 1)

@@ -109,8 +109,11 @@ class StaticDepthConfig(RigSensorConfig):
     """A fixed depth camera (time of flight), placed in the world.
 
     Defaults are the Kinect for Xbox One's depth camera: 512x424, 70.6 x 60 degrees.
-    The noise model is Gaussian with sigma ``noise_k * z^2`` (0: ideal), invalid beyond
-    ``max_range_m`` and below ``min_range_m``.
+    The noise is Gaussian with sigma ``noise_k * z^2 * (1 + off_centre_gain * rho^2)`` (0:
+    ideal; ``rho`` the pixel's distance from the image centre over the half-diagonal) plus
+    independent ``extra_noise_m``; pixels are invalid beyond ``max_range_m`` and below
+    ``min_range_m``, with probability ``edge_dropout`` on depth edges and ``random_dropout``
+    anywhere (see :mod:`rgbd_eval.sim.tof`, seed 003 4.3).
     """
 
     kind: Literal["static_depth"] = "static_depth"
@@ -126,6 +129,15 @@ class StaticDepthConfig(RigSensorConfig):
     noise_k: float = Field(0.0, ge=0.0, le=0.1, description="depth sigma = k z^2 (m)")
     min_range_m: float = Field(0.5, ge=0.0)
     max_range_m: float = Field(8.0, gt=0.5, le=50.0)
+    off_centre_gain: float = Field(
+        0.0, ge=0.0, le=10.0, description="noise growth from the image centre to a corner"
+    )
+    extra_noise_m: float = Field(
+        0.0, ge=0.0, le=1.0, description="added Gaussian depth noise std (m), seed 003 Fig. 10"
+    )
+    edge_jump: float = Field(0.05, gt=0.0, le=1.0, description="relative jump marking an edge")
+    edge_dropout: float = Field(0.0, ge=0.0, le=1.0, description="P(invalid) on a depth edge")
+    random_dropout: float = Field(0.0, ge=0.0, le=1.0, description="P(invalid) anywhere")
 
 
 class StaticDepthCamera:
@@ -158,12 +170,9 @@ class StaticDepthCamera:
         )
 
     def render_depth(self, view: SceneView) -> NDArray[np.float32]:
-        z = view.render(self.camera, self.pose).depth.astype(np.float64)
-        c = self.cfg
-        if c.noise_k > 0.0:
-            z = z + view.rng.normal(0.0, 1.0, z.shape) * c.noise_k * z * z
-        z[~np.isfinite(z) | (z < c.min_range_m) | (z > c.max_range_m)] = np.nan
-        return z.astype(np.float32)
+        from rgbd_eval.sim.tof import tof_depth  # rendering helpers: imported on use
+
+        return tof_depth(view.render(self.camera, self.pose).depth, self.cfg, view.rng)
 
 
 register_rig_sensor(RigSensorSpec("static_depth", StaticDepthConfig, StaticDepthCamera))

@@ -358,6 +358,12 @@ class Scenario(_Model):
     sensor: Sensor = Sensor()
     odometry: Odometry = Odometry()
     recording: Recording = Recording()
+    truth_visibility: Literal["kinect", "present"] = Field(
+        "kinect",
+        description="ground-truth visibility: as seen by the robot's Kinect (people it cannot "
+        "see are ignored), or 'present': everyone in the scene counts, for static multi-camera "
+        "rigs (seed 003 4.1 annotates occluded people too)",
+    )
     rig: list[SerializeAsAny[RigSensorConfig]] = Field(
         default_factory=list,
         description="extra sensors beside the robot's Kinect, each selected by its 'kind' "

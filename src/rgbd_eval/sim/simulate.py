@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import open3d as o3d
@@ -251,6 +251,8 @@ class Simulator:
             person_ground_truth(index, stamp, pid, m, top, xy, ids, self.rgb_camera, rgb_pose)
             for pid, m, top, xy in people
         ]
+        if sc.truth_visibility == "present":
+            gt = [replace(o, visibility=1.0, ignore=False) for o in gt]
         return SimFrame(index, stamp, t, rgb, depth, ids, base_true, base_odom, rgb_pose, gt)
 
     def _render(

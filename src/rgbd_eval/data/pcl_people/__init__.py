@@ -1,0 +1,1 @@
+"""The thesis authors' trained people classifier (PCL people module, BSD): see README.md."""

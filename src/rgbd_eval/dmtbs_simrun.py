@@ -1,0 +1,168 @@
+"""DMT-BS on a simulated static ToF rig, in memory: render, detect, track, score.
+
+No recording is written: the sensitivity analyses of seed 003 (4.3) vary one thing at a time
+(cameras used, added noise and background model, a camera's extrinsic error) on the same
+rendered frames, which is cheapest in memory. Runs are scored from the end of the
+background initialisation on (the seed's sequences start with a learnt background).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from rgbd_eval.config import EvaluationConfig, Gating
+from rgbd_eval.detect.dmtbs import BackgroundMethod, DepthView, DmtbsDetector, DmtbsDetectorConfig
+from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize
+from rgbd_eval.sim.tof import TofFrame
+from rgbd_eval.track.dmtbs import DmtbsTracker, DmtbsTrackerConfig
+from rgbd_eval.types import GroundTruthObject, Pose, TrackOutput
+
+#: Metric gating distance (m). The seed matches within a threshold distance whose value did
+#: not survive in its text; 0.5 m (configs/methods/dmtbs.yaml states why).
+MATCH_THRESHOLD_M = 0.5
+
+
+@dataclass(frozen=True)
+class RigRun:
+    """What one run produced: per-frame tracks, the scores, and the detector's stage times."""
+
+    tracks: list[list[TrackOutput]]
+    scores: SequenceScores
+    stage_seconds: dict[str, float]
+    splits: int
+
+    def row(self) -> dict[str, Any]:
+        """The run's headline numbers (MOTA, MOTP in m, FP, FN, ID switches)."""
+        s = summarize(self.scores.counts)
+        c = self.scores.counts
+        return {
+            "mota": s["mota"],
+            "motp_m": s["motp"],
+            "fp": c.fp,
+            "fn": c.fn,
+            "id_switches": c.id_switches,
+            "num_gt": c.num_gt,
+            "splits": self.splits,
+        }
+
+
+def yaw_error(pose: Pose, degrees: float) -> Pose:
+    """``pose`` rotated about the world's vertical through the camera (Fig. 11's error)."""
+    a = math.radians(degrees)
+    Rz = np.array([[math.cos(a), -math.sin(a), 0.0], [math.sin(a), math.cos(a), 0.0], [0, 0, 1]])
+    T = pose.matrix()
+    T[:3, :3] = Rz @ T[:3, :3]
+    return Pose.from_matrix(T)
+
+
+def with_noise(frames: Iterable[TofFrame], sigma_m: float, seed: int) -> Iterator[TofFrame]:
+    """The frames with independent Gaussian depth noise of std ``sigma_m`` added (Fig. 10).
+
+    The rig's ``extra_noise_m`` does the same at render time; adding it here reuses one
+    rendering for every level. Depths pushed to or below zero become invalid.
+    """
+    for frame in frames:
+        if sigma_m <= 0.0:
+            yield frame
+            continue
+        rng = np.random.default_rng([seed, frame.index])
+        images = []
+        for im in frame.images:
+            noise = rng.standard_normal(im.depth.shape, dtype=np.float32) * np.float32(sigma_m)
+            depth = im.depth + noise
+            depth[~(depth > 0)] = np.nan
+            images.append(replace(im, depth=depth))
+        yield replace(frame, images=images)
+
+
+def run_frames(
+    frames: Iterable[TofFrame],
+    cameras: list[str],
+    detector: DmtbsDetectorConfig,
+    tracker: DmtbsTrackerConfig,
+    threshold_m: float = MATCH_THRESHOLD_M,
+    pose_errors_deg: dict[str, float] | None = None,
+) -> RigRun:
+    """Run DMT-BS on the named cameras of rendered frames and score with metric gating.
+
+    Every present person is ground truth (:class:`~rgbd_eval.sim.tof.TofRig`); the first
+    ``detector.init_frames`` frames, where the background is being learnt, are not scored.
+    ``pose_errors_deg`` gives a camera the extrinsic yaw error of Fig. 11: the detector
+    believes the camera is rotated by that angle about the vertical.
+    """
+    errors = pose_errors_deg or {}
+    det = DmtbsDetector(detector)
+    trk = DmtbsTracker(tracker)
+    tracks: list[list[TrackOutput]] = []
+    gt: list[list[GroundTruthObject]] = []
+    for k, frame in enumerate(frames):
+        images = {im.name: im for im in frame.images}
+        missing = [c for c in cameras if c not in images]
+        if missing:
+            raise ValueError(f"frame {frame.index} has no camera {missing} (has {sorted(images)})")
+        views = []
+        for name in cameras:
+            im = images[name]
+            pose = yaw_error(im.pose, errors[name]) if name in errors else im.pose
+            views.append(DepthView(name, im.depth, im.camera, pose))
+        result = det.detect_views(frame.stamp_ns, views)
+        out = trk.update(frame.stamp_ns, result.detections)
+        if k >= detector.init_frames:
+            tracks.append(out)
+            gt.append(list(frame.ground_truth))
+    evaluation = EvaluationConfig(gating=Gating.METRIC, threshold=threshold_m)
+    scores = evaluate_sequence(gt, tracks, evaluation)
+    return RigRun(tracks, scores, dict(det.stage_seconds), trk.splits)
+
+
+# ----------------------------------------------------------------------------- experiments
+
+
+def camera_count(
+    frames: list[TofFrame], cameras: list[str], det: DmtbsDetectorConfig, trk: DmtbsTrackerConfig
+) -> list[dict[str, Any]]:
+    """Fig. 9: the same sequence with the first 1, 2, ... cameras."""
+    return [
+        {"cameras": n, **run_frames(frames, cameras[:n], det, trk).row()}
+        for n in range(1, len(cameras) + 1)
+    ]
+
+
+def depth_noise(
+    frames: list[TofFrame],
+    cameras: list[str],
+    det: DmtbsDetectorConfig,
+    trk: DmtbsTrackerConfig,
+    levels_m: list[float],
+    seed: int,
+) -> list[dict[str, Any]]:
+    """Fig. 10: added Gaussian noise, with the running average and with MOG2."""
+    rows = []
+    for method in (BackgroundMethod.RUNNING_AVERAGE, BackgroundMethod.MOG2):
+        config = det.model_copy(update={"background": method})
+        for sigma in levels_m:
+            run = run_frames(with_noise(frames, sigma, seed), cameras, config, trk)
+            rows.append({"background": method.value, "noise_m": sigma, **run.row()})
+    return rows
+
+
+def calibration_error(
+    frames: list[TofFrame],
+    cameras: list[str],
+    det: DmtbsDetectorConfig,
+    trk: DmtbsTrackerConfig,
+    errors_deg: list[float],
+) -> list[dict[str, Any]]:
+    """Fig. 11: a yaw error of the second camera's extrinsic calibration."""
+    return [
+        {
+            "yaw_error_deg": e,
+            **run_frames(frames, cameras, det, trk, pose_errors_deg={cameras[1]: e}).row(),
+        }
+        for e in errors_deg
+    ]

@@ -1,0 +1,150 @@
+"""Static time-of-flight depth cameras modelled on the Kinect for Xbox One (seed 003, 4.3).
+
+The seed's simulated sensor has the Kinect v2's properties: 512x424 depth at 30 Hz, noise
+that depends on the depth and on the pixel's distance from the image centre, "at 5 m a
+standard deviation of 5 mm for most of the pixels" (4.3.3). The model (the rig's
+``static_depth`` sensor, :mod:`rgbd_eval.sim.rig_sensors`):
+
+``sigma(z, rho) = noise_k * z^2 * (1 + off_centre_gain * rho^2)`` with ``rho`` the pixel's
+distance from the principal point over the half-diagonal (0 at the centre, ~1 in a corner):
+a ToF camera's return signal falls with the square of the distance and towards the image
+border (its illumination's vignetting), and its noise rises as the signal falls. 5 mm at 5 m
+is ``noise_k = 0.0002``. ``extra_noise_m`` adds the seed's Fig. 10 Gaussian noise on top.
+Pixels are invalid outside the working range, with probability ``edge_dropout`` on depth
+edges (the mixed "flying" pixels the Kinect SDK discards) and ``random_dropout`` anywhere.
+
+:class:`TofRig` renders a scenario's static depth cameras in memory (no recording), with
+the same bytes as ``rgbd-eval synth`` writes before the 16UC1 millimetre quantisation: the
+sensitivity analyses re-run the detector on the same rendered frames.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.scenario import Scenario
+from rgbd_eval.sim.sensor import depth_edges
+from rgbd_eval.sim.simulate import Simulator
+from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
+
+F32 = NDArray[np.float32]
+F64 = NDArray[np.float64]
+
+
+def radial_position(camera: CameraModel) -> F32:
+    """Per pixel, the distance from the principal point over the half-diagonal, squared."""
+    u = (np.arange(camera.width, dtype=np.float32) - np.float32(camera.cx)) / np.float32(
+        camera.width / 2.0
+    )
+    v = (np.arange(camera.height, dtype=np.float32) - np.float32(camera.cy)) / np.float32(
+        camera.height / 2.0
+    )
+    rho2: F32 = ((u[None, :] ** 2 + v[:, None] ** 2) / np.float32(2.0)).astype(np.float32)
+    return rho2
+
+
+def tof_sigma(z: F64, rho2: F32, cfg: StaticDepthConfig) -> F64:
+    """Noise std per pixel: the sensor's own (depth and off-centre) and the added noise."""
+    own = cfg.noise_k * z * z * (1.0 + cfg.off_centre_gain * rho2)
+    sigma: F64 = np.sqrt(own * own + cfg.extra_noise_m**2)
+    return sigma
+
+
+def tof_depth(ideal: NDArray[np.floating], cfg: StaticDepthConfig, rng: np.random.Generator) -> F32:
+    """Sensor depth (m, NaN invalid) from the ideal depth (NaN: nothing hit).
+
+    Draws one normal image when there is noise and one uniform image when there is
+    dropout, so that an ideal camera's output and its random stream stay as they were.
+    """
+    z = np.asarray(ideal, dtype=np.float64)
+    valid = np.isfinite(z)
+    if cfg.noise_k > 0.0 or cfg.extra_noise_m > 0.0:
+        camera = _camera_shape(z.shape)
+        rho2 = (
+            radial_position(camera) if cfg.off_centre_gain > 0.0 else np.zeros(z.shape, np.float32)
+        )
+        z = z + rng.normal(0.0, 1.0, z.shape) * tof_sigma(np.where(valid, z, 0.0), rho2, cfg)
+    keep = valid & (z >= cfg.min_range_m) & (z <= cfg.max_range_m)
+    if cfg.edge_dropout > 0.0 or cfg.random_dropout > 0.0:
+        edges = depth_edges(np.asarray(ideal, dtype=np.float32), cfg.edge_jump)
+        p_drop = np.where(edges, cfg.edge_dropout, cfg.random_dropout)
+        keep &= rng.random(z.shape) >= p_drop
+    out: F32 = np.where(keep, z, np.nan).astype(np.float32)
+    return out
+
+
+def _camera_shape(shape: tuple[int, ...]) -> CameraModel:
+    """A camera of this image size with a centred principal point (for ``rho``)."""
+    h, w = shape
+    return CameraModel(w, h, 1.0, 1.0, (w - 1) / 2.0, (h - 1) / 2.0)
+
+
+@dataclass(frozen=True, eq=False)
+class TofImage:
+    """One camera's depth image at one instant."""
+
+    name: str
+    depth: F32
+    camera: CameraModel
+    pose: Pose
+
+
+@dataclass(frozen=True, eq=False)
+class TofFrame:
+    """All static cameras' images at one instant, and every present person's position."""
+
+    index: int
+    stamp_ns: int
+    images: list[TofImage]
+    ground_truth: list[GroundTruthObject]
+
+
+class TofRig:
+    """Renders a scenario's ``static_depth`` rig sensors in memory, frame by frame.
+
+    Ground truth counts every person present (as ``truth_visibility: present``).
+    """
+
+    def __init__(self, scenario: Scenario, seed: int | None = None) -> None:
+        self.scenario = scenario
+        self._sim = Simulator(scenario, seed)
+        #: (stream number as in synth, camera)
+        self._cameras = [
+            (k, StaticDepthCamera(c, "world"))
+            for k, c in enumerate(scenario.rig)
+            if isinstance(c, StaticDepthConfig)
+        ]
+        if not self._cameras:
+            raise ValueError(f"scenario {scenario.name!r} has no static_depth camera in its rig")
+
+    @property
+    def names(self) -> list[str]:
+        return [cam.cfg.name for _, cam in self._cameras]
+
+    @property
+    def n_frames(self) -> int:
+        return self.scenario.n_frames
+
+    def frame(self, index: int) -> TofFrame:
+        """Render frame ``index`` (depends only on the seed and the index)."""
+        if not 0 <= index < self.n_frames:
+            raise ValueError(f"index={index} must be in [0, {self.n_frames})")
+        images = []
+        for k, cam in self._cameras:
+            view = self._sim.scene_view(index, k)
+            images.append(TofImage(cam.cfg.name, cam.render_depth(view), cam.camera, cam.pose))
+        stamp = self.scenario.stamp_ns(index)
+        gt = [
+            GroundTruthObject(index, stamp, pid, None, (xy[0], xy[1], top / 2.0))
+            for pid, _, top, xy in self._sim.people_meshes(self._sim.time(index))
+        ]
+        return TofFrame(index, stamp, images, gt)
+
+    def frames(self) -> Iterator[TofFrame]:
+        for i in range(self.n_frames):
+            yield self.frame(i)

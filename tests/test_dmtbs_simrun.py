@@ -1,0 +1,89 @@
+"""In-memory DMT-BS runs and the reproduce claims (seed 003, 4.3)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
+from rgbd_eval.dmtbs_simrun import run_frames, with_noise, yaw_error
+from rgbd_eval.methods.dmtbs import check_claims
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.tof import TofFrame, TofImage
+from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
+from rgbd_eval.types import GroundTruthObject, Pose
+
+CAM = StaticDepthCamera(
+    StaticDepthConfig(name="a", x=0.0, y=0.0, z=3.0, pitch_deg=90.0, width=64, height=48), "world"
+)
+
+
+def _frames(n: int) -> list[TofFrame]:
+    """An empty floor for 2 frames, then a 1.8 m box top under the camera, its centre truth."""
+    frames = []
+    centre = CAM.pose.transform_points(
+        CAM.camera.backproject(np.full((48, 64), 1.2))[22:28, 30:36].reshape(-1, 3)
+    )
+    xy = centre[:, :2].mean(axis=0)
+    for k in range(n):
+        depth = np.full((48, 64), 3.0, dtype=np.float32)
+        gt = []
+        if k >= 2:
+            depth[22:28, 30:36] = 1.2
+            gt = [GroundTruthObject(k, k * 33_333_333, 7, None, (float(xy[0]), float(xy[1]), 0.9))]
+        frames.append(TofFrame(k, k * 33_333_333, [TofImage("a", depth, CAM.camera, CAM.pose)], gt))
+    return frames
+
+
+def test_run_frames_scores_after_the_initialisation() -> None:
+    det = DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2))
+    run = run_frames(_frames(8), ["a"], det, DmtbsTrackerConfig(confirm_hits=3))
+    row = run.row()
+    # Frames 2..7 are scored (6 instances); the track is confirmed at its third hit (frame 4),
+    # so frames 2 and 3 are misses: MOTA = 1 - 2 / 6.
+    assert row["num_gt"] == 6 and row["fn"] == 2 and row["fp"] == 0
+    assert row["mota"] == pytest.approx(1 - 2 / 6)
+    with pytest.raises(ValueError, match="no camera"):
+        run_frames(_frames(1), ["b"], det, DmtbsTrackerConfig())
+
+
+def test_yaw_error_turns_about_the_vertical_through_the_camera() -> None:
+    pose = Pose((1.0, 2.0, 3.0), (0.0, 0.0, 0.0, 1.0))
+    turned = yaw_error(pose, 90.0)
+    assert turned.translation == pytest.approx((1.0, 2.0, 3.0))
+    # x axis -> y axis, z unchanged
+    np.testing.assert_allclose(
+        turned.rotation_matrix() @ [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], atol=1e-12
+    )
+    half = math.sqrt(0.5)
+    assert turned.rotation == pytest.approx((0.0, 0.0, half, half))
+
+
+def test_with_noise_adds_the_requested_std_and_keeps_zero_noise_frames() -> None:
+    frames = _frames(3)
+    assert next(with_noise(frames, 0.0, 1)) is frames[0]
+    noisy = list(with_noise(frames, 0.05, 1))
+    diff = noisy[0].images[0].depth - frames[0].images[0].depth
+    assert float(np.std(diff)) == pytest.approx(0.05, rel=0.1)
+    again = list(with_noise(frames, 0.05, 1))
+    np.testing.assert_array_equal(again[2].images[0].depth, noisy[2].images[0].depth)
+
+
+def _rows(mota: dict[float, float], **key: object) -> list[dict[str, object]]:
+    return [{**key, "noise_m": k, "mota": v} for k, v in mota.items()]
+
+
+def test_claims_are_checked_on_the_rows() -> None:
+    cams = [{"cameras": n, "mota": m} for n, m in ((1, 0.80), (2, 0.95), (3, 0.955), (4, 0.96))]
+    noise = _rows({0.0: 0.95, 0.05: 0.93, 0.15: 0.4}, background="running_average") + _rows(
+        {0.0: 0.96, 0.05: 0.96, 0.125: 0.95, 0.15: 0.9}, background="mog2"
+    )
+    yaw = [{"yaw_error_deg": 0.0, "mota": 0.95}, {"yaw_error_deg": 1.0, "mota": 0.94}]
+    assert [ok for _, ok in check_claims(cams, noise, yaw)] == [True, True, True, True, True]
+    # 2 -> 4 cameras gains 3 points: not "only slightly"; 1 deg costs 3 points: not tolerated.
+    cams[3]["mota"] = 0.98
+    yaw[1]["mota"] = 0.92
+    held = [ok for _, ok in check_claims(cams, noise, yaw)]
+    assert held == [False, True, True, True, False]
