@@ -7,15 +7,19 @@ from pathlib import Path
 import pytest
 
 from rgbd_eval.datasets import scenarios_dir
+from rgbd_eval.errors import ConfigError
 from rgbd_eval.reproduce import (
     THRESHOLDS,
+    VOXEL_SIZES,
     Reproduction,
     check_claims,
+    miss_counts,
     paper_values,
     render_markdown,
     reproduce_basso2012,
 )
 from rgbd_eval.sim import load_scenario, synthesize
+from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
 
 def row(
@@ -41,44 +45,152 @@ def test_paper_values_are_the_thesis_tables() -> None:
     assert sorted(p["7.6"]["rows"]) == sorted(THRESHOLDS)
 
 
-def test_claims_follow_the_numbers() -> None:
+#: Table 7.6's FP and FN per threshold (seed 000): FP 5.7% at -1.5 -> 26.6% at -3 (+20.9
+#: points), FN 5.6% at -0.5 -> 13.0% at 0.5 (+7.4), FP + FN least at -1 (4.4 + 4.0 = 8.4%).
+FP_76 = {0.5: 0.042, 0.0: 0.042, -0.5: 0.042, -1.0: 0.044, -1.5: 0.057, -1.75: 0.171,
+         -2.0: 0.213, -2.5: 0.265, -3.0: 0.266}  # fmt: skip
+FN_76 = {0.5: 0.13, 0.0: 0.078, -0.5: 0.056, -1.0: 0.04, -1.5: 0.034, -1.75: 0.032,
+         -2.0: 0.03, -2.5: 0.028, -3.0: 0.027}  # fmt: skip
+#: Figure 7.9 stage times (ms) at the six voxel sizes: only clustering changes (8 -> 2 ms).
+STAGES_79 = {"read": 1.0, "pointcloud": 0.5, "voxel": 2.0, "ground": 0.2, "clustering": 5.0,
+             "subclustering": 1.0, "features": 2.0, "hog": 3.0}  # fmt: skip
+
+
+def thesis_like() -> Reproduction:
+    """Numbers for which every claim of the thesis holds (the thesis' own where it has them)."""
+    paper = paper_values()["tables"]
     res = Reproduction()
-    res.tables["7.4"] = {"height": row(0.9, 0.05, 0.05), "confidence": row(0.4, 0.3, 0.3)}
-    res.tables["7.5"] = {"true": row(0.9, 0.05, 0.05, 1, 0.8), "false": row(0.7, 0.2, 0.07, 5, 0.6)}
-    # FP: 4% at -1.5 -> 27% at -3 (+23 points); FN: 5.6% at -0.5 -> 13% at 0.5; FP+FN least at -1.
-    fp = {
-        0.5: 0.04,
-        0.0: 0.04,
-        -0.5: 0.04,
-        -1.0: 0.04,
-        -1.5: 0.057,
-        -1.75: 0.17,
-        -2.0: 0.21,
-        -2.5: 0.26,
-        -3.0: 0.27,
+    for tab in ("7.2", "7.3"):
+        res.tables[tab] = {s: dict(r) for s, r in paper[tab]["rows"].items()}
+    res.tables["7.4"] = {"height": row(0.891, 0.053, 0.055), "confidence": row(0.388, 0.3, 0.3)}
+    res.tables["7.5"] = {
+        "true": row(0.891, 0.053, 0.055, 1, 0.8),
+        "false": row(0.728, 0.196, 0.071, 5, 0.6),
     }
-    fn = {
-        0.5: 0.13,
-        0.0: 0.08,
-        -0.5: 0.056,
-        -1.0: 0.04,
-        -1.5: 0.034,
-        -1.75: 0.032,
-        -2.0: 0.03,
-        -2.5: 0.028,
-        -3.0: 0.027,
+    res.tables["7.6"] = {
+        str(k): row(1 - FP_76[k] - FN_76[k], FP_76[k], FN_76[k]) for k in THRESHOLDS
     }
-    res.tables["7.6"] = {str(k): row(1 - fp[k] - fn[k], fp[k], fn[k]) for k in THRESHOLDS}
-    claims = {c.text: c for c in check_claims(res)}
-    assert all(c.held for c in claims.values()), claims
-    # Turn one around: without the classifier MOTA is now higher -> that claim fails.
-    res.tables["7.5"]["false"] = row(0.95, 0.01, 0.04, 0, 0.9)
-    failed = [c for c in check_claims(res) if not c.held]
-    assert {c.source for c in failed} == {"7.3, Table 7.5", "7.3"}
-    res.claims = check_claims(res)
+    res.track_lengths = {"moving_complex": {0.0: [30] * 10, 3.0: [100] * 4, 30.0: [200] * 3}}
+    for i, v in enumerate(VOXEL_SIZES):
+        t = dict(STAGES_79, clustering=8.0 - 1.2 * i)  # 8.0, 6.8, ..., 2.0 ms
+        t["total_detect"] = sum(t[k] for k in STAGES_79 if k != "read")
+        res.voxel_timing[v] = t
+    return res
+
+
+def judged(res: Reproduction) -> dict[str, bool]:
+    return {c.sentence: c.held for c in check_claims(res, paper_values()["claims"])}
+
+
+def test_every_claim_holds_on_thesis_like_numbers() -> None:
+    held = judged(thesis_like())
+    assert len(held) == len(paper_values()["claims"]) == 11
+    assert all(held.values()), held
+
+
+def _break(name: str, res: Reproduction) -> None:
+    """Change ``res`` so that the claim ``name`` (and only it) should fail."""
+    if name == "mota_per_sequence":  # 89.6% - 6 points: 6 > 5 points from the thesis
+        res.tables["7.2"]["static_obstacles"]["mota"] = 0.836
+    elif name == "motp_around_80":  # 70% is not 'around 80%' (below 75%)
+        res.tables["7.3"]["moving_simple"]["motp"] = 0.70
+    elif name == "table_7_4_drop":  # 89.1 - 79.1 = 10 points: no 'about 50' drop
+        res.tables["7.4"]["confidence"]["mota"] = 0.791
+    elif name == "table_7_5_mota":  # 89.1 - 87.1 = +2 points < 5
+        res.tables["7.5"]["false"]["mota"] = 0.871
+    elif name == "table_7_5_main_tr":  # 80% - 75% = +5 points < 10
+        res.tables["7.5"]["false"]["main_tr"] = 0.75
+    elif name == "table_7_6_low_threshold":  # FP 5.7% at -1.5 and 6.7% at -3: +1 point < 5
+        res.tables["7.6"]["-3.0"]["fp_rate"] = 0.067
+    elif name == "table_7_6_high_threshold":  # FN 5.6% -> 6.0%: +0.4 point < 2
+        res.tables["7.6"]["0.5"]["fn_rate"] = 0.06
+    elif name == "table_7_6_best_threshold":  # FP + FN 1 + 3 = 4% at -2 beats 8.4% at -1
+        res.tables["7.6"]["-2.0"]["fp_rate"] = 0.01
+    elif name == "figure_7_7_memory":  # 9 tracks at 3 s against 10 at 0 s: 0.9 > 0.8
+        res.track_lengths["moving_complex"][3.0] = [50] * 9
+    elif name == "figure_7_9_total":  # 31.7 ms + 2 ms at 0.04 m: over 33 ms
+        res.voxel_timing[VOXEL_SIZES[0]]["total_detect"] = 33.5
+    elif name == "figure_7_9_clustering":  # voxel grid 2 -> 8 ms: range 6 > 0.5 x clustering's 6
+        for i, v in enumerate(VOXEL_SIZES):
+            res.voxel_timing[v]["voxel"] = 8.0 - 1.2 * i
+    else:
+        raise AssertionError(f"no breaking case for claim {name}")
+
+
+@pytest.mark.parametrize("name", list(paper_values()["claims"]))
+def test_every_claim_can_fail(name: str) -> None:
+    res = thesis_like()
+    _break(name, res)
+    sentence = paper_values()["claims"][name]["sentence"]
+    failed = [s for s, held in judged(res).items() if not held]
+    assert failed == [sentence]
+
+
+def test_claims_render_with_their_sentences() -> None:
+    res = thesis_like()
+    _break("table_7_5_mota", res)
+    res.claims = check_claims(res, paper_values()["claims"])
     text = render_markdown(res, paper_values())
-    assert "| height | 84.1% / 80.0% | 89.1% / 90.0%" in text
-    assert "**did not hold** (7.3, Table 7.5)" in text
+    assert "| height | 84.1% / 80.0% | 89.1% / 89.1%" in text
+    assert '**did not hold** (7.3, Table 7.5) "the on-line person-specific classifier' in text
+    assert "a drop of 50.3 points" in text
+
+
+def test_claim_thresholds_are_checked() -> None:
+    claims = dict(paper_values()["claims"])
+    claims["table_7_4_drop"] = {**claims["table_7_4_drop"], "min_drop": "forty"}
+    with pytest.raises(ConfigError, match="claim threshold 'min_drop' must be a number"):
+        check_claims(thesis_like(), claims)
+    del claims["table_7_4_drop"]
+    with pytest.raises(ConfigError, match="claim 'table_7_4_drop' needs a mapping"):
+        check_claims(thesis_like(), claims)
+
+
+def test_paper_values_file_problems_are_config_errors(tmp_path: Path) -> None:
+    bad = tmp_path / "paper.yaml"
+    bad.write_text("tables: {}\nfigures: {}\n")
+    with pytest.raises(ConfigError, match="paper values need a mapping 'claims'"):
+        paper_values(bad)
+    bad.write_text("- a list\n")
+    with pytest.raises(ConfigError, match="expected a mapping at the top level"):
+        paper_values(bad)
+
+
+def test_misses_are_grouped_by_height_and_visibility() -> None:
+    def person(pid: int, left: float, z: float, vis: float) -> GroundTruthObject:
+        return GroundTruthObject(0, 0, pid, Box2D(left, 100, 50, 200), (3.0, 0.0, z), vis)
+
+    def track(tid: int, left: float, status: TrackStatus = TrackStatus.VALIDATED) -> TrackOutput:
+        return TrackOutput(
+            tid, 3.0, 0.0, 1.7, Box2D(left, 100, 50, 200), Visibility.VISIBLE, status
+        )
+
+    frames = [
+        # seated (height 2 x 0.55 = 1.1 m < 1.4 m), not covered; a standing, fully visible
+        # person covered by track 1 (same box: IoU 1)
+        [person(1, 0, 0.55, 1.0), person(2, 200, 0.85, 1.0)],
+        # 30% visible, covered by a box 10 px off: IoU = 40x200 / (2 x 50x200 - 40x200) = 2/3;
+        # 70% visible, only a NEW (unvalidated) track on it: missed
+        [person(2, 200, 0.85, 0.3), person(3, 400, 0.9, 0.7)],
+    ]
+    tracks = [[track(1, 200)], [track(1, 210), track(5, 400, TrackStatus.NEW)]]
+    got = miss_counts(frames, tracks, min_height=1.4)
+    assert got == {
+        "shorter than min_height": {"gt": 1, "missed": 1},
+        "visible < 50%": {"gt": 1, "missed": 0},
+        "visible 50-90%": {"gt": 1, "missed": 1},
+        "visible >= 90%": {"gt": 1, "missed": 0},
+    }
+    # a box 30 px off: IoU = 20x200 / (2 x 50x200 - 20x200) = 0.25 < 0.5 -> missed
+    got = miss_counts(frames[:1], [[track(1, 230)]], min_height=1.4)
+    assert got["visible >= 90%"] == {"gt": 1, "missed": 1}
+
+
+def test_two_scenarios_on_one_file_name_are_refused(tmp_path: Path) -> None:
+    one = tmp_path / "a" / "x.mcap"
+    other = tmp_path / "b" / "x.mcap"
+    with pytest.raises(ConfigError, match="two scenarios share one recording file name"):
+        reproduce_basso2012({"static_simple": one, "moving_simple": other})
 
 
 @pytest.mark.slow
@@ -86,8 +198,11 @@ def test_small_reproduction_runs(tmp_path: Path) -> None:
     scenario = load_scenario(scenarios_dir() / "demo.yaml")
     obstacles = synthesize(scenario, tmp_path / "moving_obstacles.mcap", max_frames=25).recording
     complex_ = synthesize(scenario, tmp_path / "moving_complex.mcap", max_frames=20).recording
+    clutter_sc = load_scenario(scenarios_dir() / "static_clutter.yaml")
+    clutter = synthesize(clutter_sc, tmp_path / "static_clutter.mcap", max_frames=15).recording
     res = reproduce_basso2012(
-        {"moving_obstacles": obstacles, "moving_complex": complex_}, cache=tmp_path / "cache"
+        {"moving_obstacles": obstacles, "moving_complex": complex_, "static_clutter": clutter},
+        cache=tmp_path / "cache",
     )
     assert set(res.tables["7.4"]) == {"height", "confidence"}
     assert len(res.tables["7.6"]) == len(THRESHOLDS)
@@ -95,4 +210,12 @@ def test_small_reproduction_runs(tmp_path: Path) -> None:
     assert len(res.voxel_timing) == 6 and all(
         t["total_detect"] > 0 for t in res.voxel_timing.values()
     )
-    assert res.claims and "Table 7.2" in render_markdown(res, paper_values())
+    assert set(res.clutter) == {"thesis", "static 2 s"}
+    assert set(res.clutter["thesis"]) == {"static_clutter"}
+    (t71,) = (v for k, v in res.frame_rates.items() if k.startswith("Table 7.1"))
+    assert 0 < t71["detector_tracker_fps"] < t71["detector_fps"]
+    text = render_markdown(res, paper_values())
+    assert res.claims and "Table 7.2" in text and "detector + tracker fps" in text
+    assert "| static 2 s | static_clutter |" in text
+    assert set(res.misses) == {"moving_obstacles"}
+    assert sum(g["gt"] for g in res.misses["moving_obstacles"].values()) > 0

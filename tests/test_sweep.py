@@ -91,3 +91,22 @@ def test_cli_takes_negative_values_as_values(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
     assert [r["tracker.min_confidence"] for r in records] == [-3.0, -2.5, 0.5]
+
+
+def test_cli_sweeps_a_null_value(tmp_path: Path) -> None:
+    # `sweep tracker.static_devalidation_s null 2.0` (off, then on) once crashed drawing
+    # sweep.png: float(None). Non-numeric values are plotted at evenly spaced positions.
+    import json
+
+    from typer.testing import CliRunner
+
+    from rgbd_eval.cli.main import app
+
+    rec = write_recording(tmp_path / "a.mcap", "mcap", Spec(n=4))
+    args = ["sweep", "tracker.static_devalidation_s", "null", "2.0", "--dataset", str(rec)]
+    args += ["--cache", str(tmp_path / "cache"), "--out", str(tmp_path / "out")]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    records = json.loads((tmp_path / "out" / "sweep.json").read_text())["records"]
+    assert [r["tracker.static_devalidation_s"] for r in records] == [None, 2.0]
+    assert (tmp_path / "out" / "sweep.png").stat().st_size > 0

@@ -166,6 +166,9 @@ class CameraModel:
     cy: float
     distortion: tuple[float, ...] = ()
     frame_id: str = ""
+    #: ``P[0, 3]`` of CameraInfo: ``-fx * baseline`` for the right camera of a rectified
+    #: stereo pair (ROS convention), 0 for any other camera.
+    tx: float = 0.0
 
     def __post_init__(self) -> None:
         if self.width <= 0 or self.height <= 0:
@@ -189,6 +192,7 @@ class CameraModel:
             (self.cy + 0.5) * sy - 0.5,
             self.distortion,
             self.frame_id,
+            self.tx * sx,
         )
 
     def project(self, points: FloatArray) -> FloatArray:

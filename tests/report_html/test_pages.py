@@ -159,3 +159,27 @@ def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) 
     assert "bird&#39;s-eye" not in html and "image/jpeg" not in html
     assert html.count("<img ") == 1  # the error timeline
     assert not (pages["score"].parent / "tracks.birdseye.png").exists()
+
+
+def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidence() -> None:
+    # basso2012's ReproduceResult names each claim by the thesis' sentence; the page still
+    # finds its source and evidence in the JSON data.
+    from rgbd_eval.plugins import ReproduceResult
+    from rgbd_eval.report_html.pages import _claims
+    from rgbd_eval.reproduce import Claim, Reproduction, to_json
+
+    res = Reproduction()
+    res.claims = [
+        Claim(
+            "7.3, Table 7.6",
+            "FN at 0.5 - FN at -0.5 >= 0.02",
+            True,
+            "FN 5% -> 9%",
+            "A high threshold instead",
+        )
+    ]
+    result = ReproduceResult(
+        markdown="", data=to_json(res), claims=(("A high threshold instead", True),)
+    )
+    (row,) = _claims(result)
+    assert (row.source, row.evidence) == ("7.3, Table 7.6", "FN 5% -> 9%")

@@ -45,6 +45,7 @@ def _render(x: float, y: float) -> tuple[np.ndarray, tuple[float, float, float]]
     sim.frame(0)
     cam = ThermalCamera(ThermalCameraConfig(name="thermal"), "odom")
     view = sim.scene_view(0, 0)
+    assert view.surface is not None
     ids, _ = view.surface(view.render(cam.camera, cam.pose(view)))
     vs, us = np.nonzero(ids == 1)
     u0, u1, v0, v1 = us.min(), us.max() + 1, vs.min(), vs.max() + 1

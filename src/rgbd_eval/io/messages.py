@@ -4,7 +4,9 @@ The ground-truth topic carries ``rgbd_eval_msgs/msg/GroundTruthArray``; its
 definition is registered with every typestore this module hands out, and the
 ROS1 Noetic typestore also gets ``tf2_msgs/msg/TFMessage``, which it lacks. The
 people-tracker output types ``rgbd-eval score`` reads are registered too
-(:mod:`rgbd_eval.io.track_message_types`).
+(:mod:`rgbd_eval.io.track_message_types`, which includes ``vision_msgs``), and so is
+``darknet_ros_msgs/BoundingBoxes`` (recorded 2D detections): neither stock typestore
+has them.
 """
 
 from __future__ import annotations
@@ -45,6 +47,18 @@ rgbd_eval_msgs/GroundTruthPerson[] people
 
 TF_MESSAGE_MSG = "geometry_msgs/TransformStamped[] transforms\n"
 
+DARKNET_MSGS = {
+    "darknet_ros_msgs/msg/BoundingBox": (
+        "float64 probability\nint64 xmin\nint64 ymin\nint64 xmax\nint64 ymax\nint16 id\nstring Class\n"
+    ),
+    "darknet_ros_msgs/msg/BoundingBoxes": (
+        "std_msgs/Header header\nstd_msgs/Header image_header\n"
+        "darknet_ros_msgs/BoundingBox[] bounding_boxes\n"
+    ),
+}
+DETECTION2D_ARRAY_TYPE = "vision_msgs/msg/Detection2DArray"
+BOUNDING_BOXES_TYPE = "darknet_ros_msgs/msg/BoundingBoxes"
+
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
 CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
@@ -61,7 +75,7 @@ def extra_types(ros_version: RosVersion) -> dict[str, tuple[list[object], list[o
     types.update(get_types_from_msg(GT_ARRAY_MSG, GT_ARRAY_TYPE))  # type: ignore[arg-type]
     if ros_version == 1:
         types.update(get_types_from_msg(TF_MESSAGE_MSG, TF_TYPE))  # type: ignore[arg-type]
-    for name, text in track_message_definitions(ros_version).items():
+    for name, text in (*track_message_definitions(ros_version).items(), *DARKNET_MSGS.items()):
         types.update(get_types_from_msg(text, name))  # type: ignore[arg-type]
     return types
 

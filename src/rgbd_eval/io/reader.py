@@ -191,6 +191,7 @@ def camera_model_from_info(msg: Any) -> CameraModel:
     """``sensor_msgs/CameraInfo`` (ROS1 ``K``/``D`` or ROS2 ``k``/``d``) -> CameraModel."""
     K = np.asarray(msg.K if hasattr(msg, "K") else msg.k, dtype=np.float64).reshape(3, 3)
     D = np.asarray(msg.D if hasattr(msg, "D") else msg.d, dtype=np.float64)
+    P = np.asarray(msg.P if hasattr(msg, "P") else getattr(msg, "p", ()), dtype=np.float64)
     return CameraModel(
         width=int(msg.width),
         height=int(msg.height),
@@ -200,6 +201,7 @@ def camera_model_from_info(msg: Any) -> CameraModel:
         cy=float(K[1, 2]),
         distortion=tuple(float(v) for v in D),
         frame_id=msg.header.frame_id.lstrip("/"),
+        tx=float(P[3]) if P.size == 12 else 0.0,
     )
 
 

@@ -278,7 +278,8 @@ class RecordingWriter:
     def camera_info(self, stamp_ns: int, camera: CameraModel, topic: str) -> Any:
         K = camera.K.reshape(-1)
         P = np.array(
-            [camera.fx, 0, camera.cx, 0, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0], dtype=np.float64
+            [camera.fx, 0, camera.cx, camera.tx, 0, camera.fy, camera.cy, 0, 0, 0, 1, 0],
+            dtype=np.float64,
         )
         D = np.asarray(camera.distortion or (0.0,) * 5, dtype=np.float64)
         R = np.eye(3).reshape(-1)

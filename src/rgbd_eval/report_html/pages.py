@@ -396,9 +396,12 @@ def paper_file(method: str) -> dict[str, Any] | None:
 
 def _claims(result: ReproduceResult) -> list[ClaimRow]:
     """The result's claims, with source and evidence where its data records them."""
-    details = {
-        str(c.get("text")): c for c in result.data.get("claims", []) if isinstance(c, Mapping)
-    }
+    details: dict[str, Mapping[str, Any]] = {}
+    for c in result.data.get("claims", []):
+        if isinstance(c, Mapping):
+            for key in ("text", "sentence"):  # a claim is named by either
+                if c.get(key):
+                    details[str(c[key])] = c
     rows = []
     for text, held in result.claims:
         d = details.get(text, {})

@@ -9,6 +9,7 @@ Public API (used by ``rgbd-eval synth``)::
     demo = demo_recording()  # datasets/demo.mcap, generated on first use
 """
 
+import rgbd_eval.sim.stereo_rig  # noqa: F401 - registers the stereo_pair rig sensor kind
 from rgbd_eval.sim.preview import write_preview
 from rgbd_eval.sim.scenario import Scenario, load_scenario, parse_scenario, scenario_paths
 from rgbd_eval.sim.simulate import SimFrame, Simulator

@@ -254,6 +254,16 @@ class MeshBuilder:
         M = affine(np.diag([radius, radius, height]), base)
         self.add(v, n, t, M, colour, object_id, material)
 
+    def extend(self, mesh: Mesh) -> None:
+        """Add a ready mesh (its own colours, ids and materials) as it is."""
+        self._v.append(mesh.vertices)
+        self._n.append(mesh.normals)
+        self._t.append(mesh.triangles + self._count)
+        self._c.append(mesh.colours)
+        self._o.append(mesh.object_ids)
+        self._m.append(mesh.materials)
+        self._count += len(mesh.vertices)
+
     def build(self) -> Mesh:
         if not self._t:
             return empty_mesh()

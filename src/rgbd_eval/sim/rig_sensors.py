@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Literal, Protocol
 
 import numpy as np
@@ -50,11 +50,14 @@ class SceneView:
     #: Ray-cast static scene + people from ``pose`` (world_T_optical) through ``camera``.
     render: Callable[[CameraModel, Pose], Hits]
     rng: np.random.Generator
+    #: world_T_base_link of the robot at this instant (robot-mounted sensors render from it).
+    base_pose: Pose = field(default_factory=Pose.identity)
+    #: Lit colour ((H, W, 3) float32, 0..255) of rendered hits, as the Kinect's RGB is shaded.
+    shade: Callable[[Hits], NDArray[np.float32]] | None = None
     #: Per-pixel (object id, material) of a :meth:`render` result (``NO_HIT``, -1: nothing).
-    surface: Callable[[Hits], tuple[NDArray[np.int32], NDArray[np.int32]]]
-    #: The colour camera's tf frame and true world_T_optical (robot-mounted sensors sit on it).
-    rgb_frame: str
-    rgb_pose: Pose
+    surface: Callable[[Hits], tuple[NDArray[np.int32], NDArray[np.int32]]] | None = None
+    #: The colour camera's true world_T_optical (the thermal camera sits beside it).
+    rgb_pose: Pose = field(default_factory=Pose.identity)
 
 
 class RigSensor(Protocol):

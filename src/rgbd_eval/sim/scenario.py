@@ -74,7 +74,12 @@ class Room(_Model):
 
 
 class ObstacleKind(enum.Enum):
-    """Furniture and person-sized non-person objects (false candidates for clustering)."""
+    """Furniture and person-sized non-person objects (false candidates for clustering).
+
+    The thesis' obstacles (seed 000, 7.1) occlude people: box, pillar, table, chair, sofa.
+    Coat stand, plant, cabinet and mannequin are person-sized clutter for the stress
+    scenarios ``static_clutter`` and ``moving_clutter``.
+    """
 
     BOX = "box"
     PILLAR = "pillar"
@@ -85,6 +90,7 @@ class ObstacleKind(enum.Enum):
     PLANT = "plant"
     CABINET = "cabinet"
     PICTURE = "picture"
+    MANNEQUIN = "mannequin"
 
 
 #: Default (length x, width y, height z) in metres per kind.
@@ -98,6 +104,7 @@ DEFAULT_SIZES: dict[ObstacleKind, tuple[float, float, float]] = {
     ObstacleKind.PLANT: (1.0, 1.0, 1.7),
     ObstacleKind.CABINET: (0.5, 0.9, 1.85),
     ObstacleKind.PICTURE: (0.03, 0.8, 0.6),
+    ObstacleKind.MANNEQUIN: (0.5, 0.5, 1.75),
 }
 
 DEFAULT_COLOURS: dict[ObstacleKind, Colour] = {
@@ -110,6 +117,7 @@ DEFAULT_COLOURS: dict[ObstacleKind, Colour] = {
     ObstacleKind.PLANT: (40, 110, 45),
     ObstacleKind.CABINET: (175, 170, 160),
     ObstacleKind.PICTURE: (60, 90, 140),
+    ObstacleKind.MANNEQUIN: (200, 180, 160),
 }
 
 

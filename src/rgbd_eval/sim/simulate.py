@@ -295,19 +295,22 @@ class Simulator:
             mats = np.where(tri >= 0, mats_all[safe], -1).astype(np.int32)
             return ids, mats
 
-        index_pose = self.true_poses[index]
-        base = rig.base_pose(float(index_pose[0]), float(index_pose[1]), float(index_pose[2]))
-        rgb_pose = base.compose(self.base_to_link).compose(self.link_to_rgb)
+        def lit(hits: Hits) -> NDArray[np.float32]:
+            mesh = concatenate([self.static, people_mesh])
+            return shade(mesh, hits, self.light, self.scenario.room.floor_tile)
 
+        x, y, yaw = self.true_poses[index]
+        base = rig.base_pose(float(x), float(y), float(yaw))
         return SceneView(
             index,
             self.scenario.stamp_ns(index),
             rig.WORLD_FRAME,
             render,
             _rng(self.seed, _STREAM_RIG + stream, index),
+            base,
+            lit,
             surface,
-            rig.RGB_FRAME,
-            rgb_pose,
+            base.compose(self.base_to_link).compose(self.link_to_rgb),
         )
 
     def frames(self, indices: list[int] | None = None) -> Iterator[SimFrame]:

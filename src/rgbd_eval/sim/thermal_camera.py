@@ -117,6 +117,8 @@ class ThermalCamera:
 
     def temperatures(self, view: SceneView) -> NDArray[np.float64]:
         """The ideal (sharp, noiseless) apparent temperature image (deg C)."""
+        if view.surface is None:
+            raise ValueError("the thermal camera needs the scene's per-pixel object ids")
         hits = view.render(self.camera, self.pose(view))
         ids, mats = view.surface(hits)
         return self.surface_temperatures(hits, ids, mats)

@@ -7,9 +7,11 @@ obstacle ``i``; people use their own ids (1..10000); :data:`NO_HIT` is empty spa
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
+from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.meshes import (
     F64,
     MAT_FLOOR,
@@ -149,6 +151,16 @@ def obstacle_mesh(ob: Obstacle, object_id: int, b: MeshBuilder) -> None:
             b.box(door, (0.01, sy / 2 - 0.03, sz - 0.25), R, _f(ob.rgb, 0.9), object_id, mat)
             handle = at(sx / 2 + 0.02, iy * 0.05, sz / 2 + 0.05)
             b.box(handle, (0.02, 0.015, 0.15), R, (60, 60, 60), object_id, MAT_SHINY)
+    elif kind is ObstacleKind.MANNEQUIN:
+        # a shop dummy: the walking figures' body in one plastic colour (no hair, no
+        # clothes edges) standing still on a round base plate
+        plastic = ob.rgb
+        outfit = Outfit(plastic, plastic, plastic, plastic, plastic)
+        figure, _top = figure_mesh(
+            sz, ob.x, ob.y, math.radians(ob.yaw_deg), Posture(), outfit, object_id
+        )
+        b.extend(replace(figure, vertices=figure.vertices + np.array([0.0, 0.0, ob.z])))
+        b.cylinder(o, min(sx, sy) / 2 - 0.02, 0.02, _f(ob.rgb, 0.5), object_id, MAT_SHINY)
     else:  # pragma: no cover - exhaustive over ObstacleKind
         raise ValueError(f"unknown obstacle kind {kind}")
 

@@ -16,6 +16,14 @@ Per frame, in the world frame of odometry (6.5.1):
 7. a track not visible for ``frames_before_old`` leaves the output; its classifier is
    kept for ``classifier_memory_s`` (Figure 7.7) for steps 3 and 6, then dropped (6.4.4).
 
+Beyond the thesis, off by default (``static_devalidation_s``): a validated track whose
+detections over that window all scored below the detector's person threshold
+(``static_max_confidence``, as ``detector.min_confidence`` in Table 5.1: -1.5, "not a person") and stayed within
+``static_motion_m`` of their mean is discarded, as a fake track is. People walk or
+score above that threshold; a coat stand or a plant that once got three confident
+detections stays put and scores low. The cost: a person who stands still while
+hidden from HOG (sitting, cut by the image border) loses the track.
+
 Frame counts are turned into seconds at ``reference_rate_hz`` and compared with
 stamp differences, so dropped frames and other rates keep their meaning in time.
 
@@ -31,6 +39,7 @@ detection's height.
 from __future__ import annotations
 
 import math
+from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
@@ -82,6 +91,8 @@ class _Track:
     classifier: OnlineBoostingClassifier | None
     detection: int | None = None  # index into this frame's detections, or None
     by_classifier: bool = False  # this frame's detection came from the classifier step
+    # (stamp, x, y, confidence) of recent detections, for static_devalidation_s only
+    recent: deque[tuple[int, float, float, float]] | None = None
 
 
 class Basso2012Tracker:
@@ -112,6 +123,9 @@ class Basso2012Tracker:
             else cfg.seconds(cfg.frames_before_old)
         )
         self._memory_ns = _ns(memory_s)
+        static_s = cfg.static_devalidation_s
+        self._static_ns = None if static_s is None else _ns(static_s)
+        self._not_person = cfg.static_max_confidence  # Table 5.1 ~people/min_confidence
         self._x = np.zeros((0, 4))
         self._P = np.zeros((0, 4, 4))
         self._tracks: list[_Track] = []
@@ -166,7 +180,7 @@ class Basso2012Tracker:
                 raise ValueError(f"detection position {d.position} is not finite")
             if not (math.isfinite(d.distance) and d.distance >= 0.0):
                 raise ValueError(f"detection distance={d.distance} must be finite and >= 0")
-            if d.appearance is not None and d.appearance.shape != (size,):
+            if self._cfg.classifier and d.appearance is not None and d.appearance.shape != (size,):
                 raise ValueError(
                     f"detection appearance has shape {d.appearance.shape}, expected ({size},) "
                     f"for histogram_bins={self._bins}"
@@ -258,6 +272,15 @@ class Basso2012Tracker:
     def _mark_seen(self, track: _Track, det: Detection, stamp_ns: int) -> None:
         track.last_seen_ns = stamp_ns
         track.height = det.height
+        if self._static_ns is not None:
+            if track.recent is None:
+                track.recent = deque()
+            x, y = det.ground_xy
+            track.recent.append((stamp_ns, x, y, det.confidence))
+            # keep one detection at or before the window's start: it shows the window is covered
+            start = stamp_ns - self._static_ns
+            while len(track.recent) > 1 and track.recent[1][0] <= start:
+                track.recent.popleft()
         if det.confidence > self._cfg.min_confidence:
             track.confident += 1
             if track.confident >= self._cfg.detections_to_validate:
@@ -360,8 +383,24 @@ class Basso2012Tracker:
             age = stamp_ns - t.created_ns + STAMP_TOLERANCE_NS
             fake = not t.validated and age >= self._fake_ns
             forgotten = self._dormant(t, stamp_ns) and not self._remembers(t, stamp_ns)
-            keep.append(not fake and not forgotten)
+            keep.append(not fake and not forgotten and not self._static(t, stamp_ns))
         self._keep(keep)
+
+    def _static(self, t: _Track, stamp_ns: int) -> bool:
+        """``static_devalidation_s``: seen, "not a person" and motionless for the whole window."""
+        if self._static_ns is None or not t.validated or t.recent is None:
+            return False
+        recent = t.recent
+        covered = recent[0][0] <= stamp_ns - self._static_ns + STAMP_TOLERANCE_NS
+        if t.last_seen_ns != stamp_ns or not covered:
+            return False
+        if len(recent) < self._cfg.detections_to_validate:
+            return False
+        if max(r[3] for r in recent) >= self._not_person:
+            return False
+        xy = np.array([(r[1], r[2]) for r in recent])
+        spread = float(np.max(np.linalg.norm(xy - xy.mean(axis=0), axis=1)))
+        return spread <= self._cfg.static_motion_m
 
     def _outputs(self, stamp_ns: int, dets: list[Detection]) -> list[TrackOutput]:
         out = []

@@ -81,6 +81,26 @@ class Basso2012TrackerConfig(ComponentConfig):
         description="floor of the gain of the weak classifiers' running class means "
         "(seed 000 6.5.3 follows Grabner and Bischof [13]; the value is not given)",
     )
+    static_devalidation_s: float | None = Field(
+        None,
+        gt=0.0,
+        le=600.0,
+        description="beyond the thesis, off by default: discard a validated track whose "
+        "detections for this many seconds all scored below static_max_confidence and stayed "
+        "within static_motion_m of their mean (a track held by a coat stand or a plant)",
+    )
+    static_max_confidence: float = Field(
+        -1.5,
+        description="for static_devalidation_s, a detection scoring below this is 'not a "
+        "person': the detector's threshold, Table 5.1 ~people/min_confidence",
+    )
+    static_motion_m: float = Field(
+        0.3,
+        gt=0.0,
+        le=5.0,
+        description="largest distance (m) from the window's mean position that counts as "
+        "not moving, for static_devalidation_s",
+    )
 
     @model_validator(mode="after")
     def _check(self) -> Basso2012TrackerConfig:

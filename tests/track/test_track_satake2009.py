@@ -1,0 +1,96 @@
+"""satake2009 tracker: robot motion from the frame's odometry, output in the world frame."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from rgbd_eval.detect.satake2009 import Satake2009DetectorConfig, distance_grid
+from rgbd_eval.plugins import DetectionContract
+from rgbd_eval.track.satake2009 import Satake2009Tracker, Satake2009TrackerConfig, planar_pose
+from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, Detection, Frame, Pose, Stream
+
+CAM = CameraModel(64, 48, 40.0, 40.0, 31.5, 23.5)
+
+
+def _frame(index: int, x: float, y: float, yaw: float) -> Frame:
+    """A frame whose left camera stands at (x, y, 1.2) looking along ``yaw``."""
+    T = np.eye(4)
+    c, s = math.cos(yaw), math.sin(yaw)
+    T[:3, :3] = [[c, -s, 0], [s, c, 0], [0, 0, 1]]
+    T[:3, 3] = (x, y, 1.2)
+    pose = Pose.from_matrix(T).compose(OPTICAL_TO_BODY)
+    img = np.zeros((48, 64, 3), np.uint8)
+    stamp = index * 50_000_000  # 20 fps
+    left = Stream(img, "rgb8", CAM, stamp, pose)
+    return Frame(index, stamp, {"left": left, "right": left}, camera_pose=pose, has_odometry=True)
+
+
+def test_planar_pose_reads_the_heading_of_the_optical_axis() -> None:
+    assert planar_pose(_frame(0, 1.0, 2.0, 0.5).stream("left").pose) == pytest.approx((1, 2, 0.5))
+
+
+def test_a_static_person_stays_put_while_the_robot_drives_and_turns() -> None:
+    # The robot drives an arc (0.3 m/s, 0.4 rad/s); a person stands at world (4, 1).
+    # Detections are exact, so every output must be (4, 1) with one id; the EKF's
+    # prediction in the robot frame must agree with the next detection (no new ids).
+    trk = Satake2009Tracker(Satake2009TrackerConfig(sigma_v=0.05), DetectionContract())
+    box = Box2D(0, 0, 1, 1)
+    for k in range(40):
+        t = k * 0.05
+        yaw = 0.4 * t
+        x, y = (0.3 / 0.4) * math.sin(yaw), (0.3 / 0.4) * (1 - math.cos(yaw))
+        out = trk.update(
+            k * 50_000_000, [Detection((4.0, 1.0, 1.7), 1.7, 1.0, box)], _frame(k, x, y, yaw)
+        )
+        if k >= 1:
+            assert [o.track_id for o in out] == [1]
+            assert (out[0].x, out[0].y) == (
+                pytest.approx(4.0, abs=1e-9),
+                pytest.approx(1.0, abs=1e-9),
+            )
+    # the velocity estimate of a standing person stays near zero despite the robot's motion
+    assert np.hypot(*trk.tracks[0].x[3:]) < 0.05
+
+
+def test_an_unseen_track_is_kept_for_max_missed_s_then_dropped() -> None:
+    # 20 fps, max_missed_s = 0.5: seen at frames 0-2, kept (occluded) through frame 12
+    # (0.5 s after frame 2), gone at frame 13. With coast_min_hits = 4 it would not be
+    # output at all once unseen (3 matches).
+    cfg = Satake2009TrackerConfig(max_missed_s=0.5, coast_min_hits=3)
+    trk = Satake2009Tracker(cfg, DetectionContract())
+    det = [Detection((3.0, 0.0, 1.7), 1.7, 1.0, Box2D(0, 0, 1, 1))]
+    for k in range(3):
+        trk.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
+    for k in range(3, 13):
+        out = trk.update(k * 50_000_000, [], _frame(k, 0.0, 0.0, 0.0))
+        assert [(o.track_id, o.visibility.name) for o in out] == [(1, "OCCLUDED")]
+    assert trk.update(13 * 50_000_000, [], _frame(13, 0.0, 0.0, 0.0)) == []
+    strict = Satake2009Tracker(cfg.model_copy(update={"coast_min_hits": 4}), DetectionContract())
+    for k in range(3):
+        strict.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
+    assert strict.update(3 * 50_000_000, [], _frame(3, 0.0, 0.0, 0.0)) == []
+    assert len(strict.tracks) == 1  # still kept, only not output
+
+
+def test_a_second_match_on_the_same_body_starts_no_track() -> None:
+    # Two detections 0.3 m apart (< min_separation_m = 0.5): the first starts track 1; the
+    # second, unmatched, is within 0.5 m of it and starts nothing. At 0.8 m it would.
+    box = Box2D(0, 0, 1, 1)
+    for gap, n_tracks in ((0.3, 1), (0.8, 2)):
+        trk = Satake2009Tracker(Satake2009TrackerConfig(), DetectionContract())
+        trk.update(0, [Detection((3.0, 0.0, 1.7), 1.7, 1.0, box)], _frame(0, 0.0, 0.0, 0.0))
+        dets = [
+            Detection((3.0, 0.0, 1.7), 1.7, 1.0, box),
+            Detection((3.0, gap, 1.7), 1.7, 1.0, box),
+        ]
+        trk.update(50_000_000, dets, _frame(1, 0.0, 0.0, 0.0))
+        assert len(trk.tracks) == n_tracks
+
+
+def test_distance_grid() -> None:
+    # 1.0 * 1.5^k up to 3.5: 1.0, 1.5, 2.25, 3.375
+    cfg = Satake2009DetectorConfig(min_distance_m=1.0, max_distance_m=3.5, distance_ratio=1.5)
+    assert distance_grid(cfg) == pytest.approx([1.0, 1.5, 2.25, 3.375])
