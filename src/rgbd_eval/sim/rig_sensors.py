@@ -5,7 +5,7 @@ config model (registered here, like detectors and trackers in :mod:`rgbd_eval.pl
 and whose ``name`` becomes its topic namespace (``/<name>/...``) and tf frame
 (``<name>_optical_frame``). The writer puts each sensor on its own topics, with its
 tf: a static sensor as ``/tf_static`` from the world frame, a robot-mounted one from
-``base_link``. Method issues add kinds (stereo pair, thermal camera, wheel encoders);
+``base_link`` (or the colour camera's frame). Method issues add kinds (stereo pair, thermal camera, wheel encoders);
 ``static_depth`` (a fixed time-of-flight depth camera) is built in.
 
 A sensor renders from the same scene as the Kinect, frame by frame, through
@@ -54,6 +54,10 @@ class SceneView:
     base_pose: Pose = field(default_factory=Pose.identity)
     #: Lit colour ((H, W, 3) float32, 0..255) of rendered hits, as the Kinect's RGB is shaded.
     shade: Callable[[Hits], NDArray[np.float32]] | None = None
+    #: Per-pixel (object id, material) of a :meth:`render` result (``NO_HIT``, -1: nothing).
+    surface: Callable[[Hits], tuple[NDArray[np.int32], NDArray[np.int32]]] | None = None
+    #: The colour camera's true world_T_optical (the thermal camera sits beside it).
+    rgb_pose: Pose = field(default_factory=Pose.identity)
 
 
 class RigSensor(Protocol):
@@ -175,3 +179,7 @@ class StaticDepthCamera:
 
 
 register_rig_sensor(RigSensorSpec("static_depth", StaticDepthConfig, StaticDepthCamera))
+
+
+# the kinds that live in their own modules register on import (at the end: they import this one)
+from rgbd_eval.sim import thermal_camera as _thermal_camera  # noqa: E402, F401

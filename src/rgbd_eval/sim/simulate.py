@@ -52,7 +52,7 @@ from rgbd_eval.sim.sensor import (
     noisy_depth,
     noisy_rgb,
 )
-from rgbd_eval.sim.world import static_mesh
+from rgbd_eval.sim.world import NO_HIT, static_mesh
 from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
 
 # Random stream numbers (never reorder: they fix the bytes of every recording).
@@ -285,19 +285,32 @@ class Simulator:
         def render(camera: CameraModel, pose: Pose) -> Hits:
             return self._render(people_mesh, people_scene, camera, pose)
 
+        ids_all = np.concatenate([self.static.object_ids, people_mesh.object_ids])
+        mats_all = np.concatenate([self.static.materials, people_mesh.materials])
+
+        def surface(hits: Hits) -> tuple[NDArray[np.int32], NDArray[np.int32]]:
+            tri = hits.triangle
+            safe = np.maximum(tri, 0)
+            ids = np.where(tri >= 0, ids_all[safe], NO_HIT).astype(np.int32)
+            mats = np.where(tri >= 0, mats_all[safe], -1).astype(np.int32)
+            return ids, mats
+
         def lit(hits: Hits) -> NDArray[np.float32]:
             mesh = concatenate([self.static, people_mesh])
             return shade(mesh, hits, self.light, self.scenario.room.floor_tile)
 
         x, y, yaw = self.true_poses[index]
+        base = rig.base_pose(float(x), float(y), float(yaw))
         return SceneView(
             index,
             self.scenario.stamp_ns(index),
             rig.WORLD_FRAME,
             render,
             _rng(self.seed, _STREAM_RIG + stream, index),
-            rig.base_pose(float(x), float(y), float(yaw)),
+            base,
             lit,
+            surface,
+            base.compose(self.base_to_link).compose(self.link_to_rgb),
         )
 
     def frames(self, indices: list[int] | None = None) -> Iterator[SimFrame]:

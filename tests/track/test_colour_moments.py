@@ -1,0 +1,89 @@
+"""Colour moments by integral images (seed 004, section 4; Stricker and Orengo 1995)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from rgbd_eval.track.colour_moments import (
+    ColourModel,
+    IntegralMoments,
+    MomentWeights,
+    moment_distance,
+    person_moments,
+    region_boxes,
+)
+
+
+def _direct(image: np.ndarray, box: tuple[int, int, int, int]) -> np.ndarray:
+    u0, v0, u1, v1 = box
+    p = image[v0:v1, u0:u1].reshape(-1, image.shape[2]).astype(np.float64)
+    mean = p.mean(axis=0)
+    std = np.sqrt(((p - mean) ** 2).mean(axis=0))
+    skew = np.cbrt(((p - mean) ** 3).mean(axis=0))
+    return np.stack([mean, std, skew])
+
+
+def test_integral_moments_equal_direct_computation() -> None:
+    rng = np.random.default_rng(0)
+    # skewed channels (exponential) so that the third moment is far from zero
+    image = np.clip(rng.exponential(40.0, (60, 80, 3)), 0, 255).astype(np.uint8)
+    integral = IntegralMoments.of(image)
+    for _ in range(50):
+        u0, u1 = sorted(rng.integers(0, 81, 2))
+        v0, v1 = sorted(rng.integers(0, 61, 2))
+        if u1 == u0 or v1 == v0:
+            continue
+        box = (int(u0), int(v0), int(u1), int(v1))
+        np.testing.assert_allclose(integral.moments(box), _direct(image, box), atol=1e-6)
+
+
+def test_hand_computed_moments_of_a_small_patch() -> None:
+    # one channel, values 0, 0, 0, 4: mean 1, variance (1+1+1+9)/4 = 3,
+    # third central moment (-1-1-1+27)/4 = 6 -> skewness 6^(1/3)
+    image = np.array([[0, 0], [0, 4]], dtype=np.uint8)
+    m = IntegralMoments.of(image).moments((0, 0, 2, 2))
+    np.testing.assert_allclose(m[:, 0], [1.0, np.sqrt(3.0), 6.0 ** (1 / 3)])
+
+
+def test_empty_and_clipped_boxes() -> None:
+    integral = IntegralMoments.of(np.ones((4, 4, 3)))
+    assert np.isnan(integral.moments((2, 2, 2, 3))).all()
+    # a box beyond the image is clipped to it: all ones -> mean 1, std 0, skew 0
+    np.testing.assert_allclose(integral.moments((-5, -5, 10, 10))[:, 0], [1.0, 0.0, 0.0])
+
+
+def test_regions_split_the_box_head_torso_legs() -> None:
+    # box 100 wide, 200 tall at (0, 0): head 0..26 (0.13 * 200) 33 wide around u=50
+    assert region_boxes(np.array([0.0, 0.0, 100.0, 200.0])) == [
+        (34, 0, 66, 26),  # 50 -+ 16.5, rounded half to even
+        (6, 26, 94, 104),  # 50 -+ 43.5; 0.52 * 200 = 104
+        (20, 104, 80, 200),
+    ]
+
+
+def test_red_shirt_and_blue_shirt_are_told_apart() -> None:
+    image = np.zeros((200, 200, 3), dtype=np.uint8)
+    image[:, :100] = (200, 30, 30)
+    image[:, 100:] = (30, 30, 200)
+    integral = IntegralMoments.of(image)
+    red = person_moments(integral, np.array([20.0, 20.0, 80.0, 180.0]))
+    red2 = person_moments(integral, np.array([25.0, 15.0, 85.0, 175.0]))
+    blue = person_moments(integral, np.array([120.0, 20.0, 180.0, 180.0]))
+    # same colour: all moments equal; red vs blue: |200-30| on two channels per region,
+    # std and skew 0 -> 340 per region
+    assert moment_distance(red, red2) == pytest.approx(0.0)
+    assert moment_distance(red, blue) == pytest.approx(340.0)
+    assert moment_distance(red, blue, MomentWeights(mean=0.5)) == pytest.approx(170.0)
+
+
+def test_adaptive_update_blends_and_keeps_unobserved_regions() -> None:
+    old = ColourModel(np.array([[[10.0]], [[20.0]]]))
+    obs = np.array([[[20.0]], [[np.nan]]])
+    new = old.updated(obs, 0.25)
+    # region 0: 0.75 * 10 + 0.25 * 20 = 12.5; region 1 not observed: kept
+    np.testing.assert_allclose(new.moments[:, 0, 0], [12.5, 20.0])
+    fresh = ColourModel(np.full((2, 1, 1), np.nan)).updated(obs, 0.25)
+    assert fresh.moments[0, 0, 0] == 20.0 and np.isnan(fresh.moments[1, 0, 0])
+    with pytest.raises(ValueError, match="alpha"):
+        old.updated(obs, 1.5)

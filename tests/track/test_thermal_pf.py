@@ -1,0 +1,147 @@
+"""The thermal silhouette measurement and particle filter (seed 004, section 3)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import ndimage
+
+from rgbd_eval.sim import Simulator, parse_scenario
+from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig, counts_to_celsius
+from rgbd_eval.track.silhouette import GradientImage, Silhouette, silhouette_scores
+from rgbd_eval.track.thermal_pf import (
+    FilterParams,
+    ThermalParticleFilter,
+    box_iou,
+    step_filters,
+    systematic_resample,
+)
+
+SIL = Silhouette.head_and_body()
+
+
+def _scene(x: float, y: float) -> dict[str, object]:
+    return {
+        "name": "pf_test",
+        "duration_s": 0.1,
+        "room": {"x_min": -1.0, "x_max": 9.0, "y_min": -4.0, "y_max": 4.0},
+        "people": [
+            {
+                "id": 1,
+                "height": 1.75,
+                "shirt": [60, 60, 160],
+                "trousers": [40, 40, 40],
+                "path": [{"x": x, "y": y}, {"x": x + 0.01, "y": y, "speed": 0.1}],
+            }
+        ],
+        "robot": {"camera_tilt_deg": 0.0},
+        "sensor": {"depth_decimation": 4},
+    }
+
+
+def _render(x: float, y: float) -> tuple[np.ndarray, tuple[float, float, float]]:
+    """A noisy thermal image of one person, and the person's true (u, v, h) from the id mask."""
+    sim = Simulator(parse_scenario(_scene(x, y)), seed=3)
+    sim.frame(0)
+    cam = ThermalCamera(ThermalCameraConfig(name="thermal"), "odom")
+    view = sim.scene_view(0, 0)
+    assert view.surface is not None
+    ids, _ = view.surface(view.render(cam.camera, cam.pose(view)))
+    vs, us = np.nonzero(ids == 1)
+    u0, u1, v0, v1 = us.min(), us.max() + 1, vs.min(), vs.max() + 1
+    temp = counts_to_celsius(cam.render_counts(view))
+    return temp, ((u0 + u1) / 2.0, (v0 + v1) / 2.0, float(v1 - v0))
+
+
+@pytest.mark.parametrize(("x", "y"), [(3.5, 0.0), (5.0, 0.8), (4.0, -1.0)])
+def test_silhouette_score_peaks_at_the_true_pose_of_a_rendered_person(x: float, y: float) -> None:
+    temp, (u, v, h) = _render(x, y)
+    grad = GradientImage.of(temp)
+    # a grid of +-30% of h in position and +-30% in size, in steps of 2% of h
+    steps = np.arange(-0.30, 0.301, 0.02)
+    du, dv, ds = np.meshgrid(steps, steps, steps, indexing="ij")
+    states = np.stack([u + du.ravel() * h, v + dv.ravel() * h, h * (1 + ds.ravel())], axis=1)
+    scores = silhouette_scores(grad, SIL, states)
+    best = states[int(np.argmax(scores))]
+    # (people 3.5-5 m away are seen whole: the id mask's box is the true pose)
+    # the best state lies within 4% of h of the true centre and 8% of its size
+    assert abs(best[0] - u) <= 0.04 * h
+    assert abs(best[1] - v) <= 0.04 * h
+    assert abs(best[2] - h) <= 0.08 * h
+    # and it scores well above a displaced silhouette (a quarter height to the side)
+    off = silhouette_scores(grad, SIL, np.array([[u + 0.25 * h, v, h]]))[0]
+    assert scores.max() > 2.0 * off
+
+
+def _blob_image(people: list[tuple[float, float, float, float]]) -> np.ndarray:
+    """A hand-made thermal image: 20 C room, filled silhouettes (u, v, h, temperature)."""
+    H, W = 240, 320
+    yy, xx = np.mgrid[0:H, 0:W].astype(np.float64)
+    img = np.full((H, W), 20.0)
+    for u, v, h, t in people:
+        inside = np.zeros((H, W), dtype=bool)
+        for cy, a, b in ((-0.435, 0.05, 0.065), (-0.175, 0.13, 0.195), (0.26, 0.09, 0.24)):
+            inside |= ((xx - u) / (a * h)) ** 2 + ((yy - (v + cy * h)) / (b * h)) ** 2 <= 1
+        img[inside] = t
+    return ndimage.gaussian_filter(img, 0.7)
+
+
+def test_filter_locks_on_from_a_uniform_start_and_is_bit_identical_per_seed() -> None:
+    grad = GradientImage.of(_blob_image([(200.0, 120.0, 150.0, 30.0)]))
+    runs = []
+    for _ in range(2):
+        f = ThermalParticleFilter.uniform(
+            FilterParams(), SIL, (240, 320), (40.0, 220.0), np.random.default_rng(7)
+        )
+        for _ in range(15):
+            f.step(grad, 1 / 30)
+        runs.append(f.estimate.copy())
+    np.testing.assert_array_equal(runs[0], runs[1])
+    u, v, h = runs[0][:3]
+    assert abs(u - 200.0) < 5.0 and abs(v - 120.0) < 5.0 and abs(h - 150.0) < 12.0
+
+
+@pytest.mark.parametrize("rho", [2.0, 0.0])
+def test_interaction_factor_keeps_two_filters_on_two_people(rho: float) -> None:
+    # person A (u=110, 26 C) is cooler than person B (u=190, 34 C). One filter tracks B;
+    # a second one starts between them, spread over both (sigma 0.3 h = 45 px). Without
+    # interaction it is fetched by B's stronger gradient; with rho it settles on A.
+    grad = GradientImage.of(_blob_image([(110.0, 120.0, 150.0, 26.0), (190.0, 120.0, 150.0, 34.0)]))
+    params = FilterParams(rho=rho)
+    for seed in range(3):
+        rng = np.random.default_rng(seed)
+        on_b = ThermalParticleFilter.around(
+            params, SIL, np.array([190.0, 120, 150, 0, 0, 1]), 0.05, rng
+        )
+        new = ThermalParticleFilter.around(
+            params, SIL, np.array([150.0, 120, 150, 0, 0, 1]), 0.3, rng
+        )
+        for _ in range(30):
+            step_filters([on_b, new], grad, 1 / 30)
+        assert abs(on_b.estimate[0] - 190.0) < 5.0
+        # the test can fail: with rho = 0 the second filter ends on B too
+        assert abs(new.estimate[0] - (110.0 if rho > 0.0 else 190.0)) < 5.0
+
+
+def test_box_iou_hand_computed() -> None:
+    # (0,0,2,2) and (1,1,3,3): intersection 1, union 4 + 4 - 1 = 7
+    iou = box_iou(
+        np.array([[0.0, 0.0, 2.0, 2.0], [5.0, 5.0, 6.0, 6.0]]), np.array([1.0, 1.0, 3.0, 3.0])
+    )
+    np.testing.assert_allclose(iou, [1 / 7, 0.0])
+    # over the smaller box: (0,0,4,4) holds (1,1,2,2) entirely -> 1; IoU 1/16
+    big, small = np.array([[0.0, 0.0, 4.0, 4.0]]), np.array([1.0, 1.0, 2.0, 2.0])
+    assert box_iou(big, small, of_smaller=True)[0] == 1.0
+    assert box_iou(big, small)[0] == 1 / 16
+
+
+def test_systematic_resample_counts_follow_weights() -> None:
+    # weights 0.5, 0.25, 0.25 with 4 particles (the fourth weight 0): positions
+    # (r + k) / 4 fall 2, 1, 1, 0 times into the cumulative intervals
+    idx = systematic_resample(np.array([0.5, 0.25, 0.25, 0.0]), np.random.default_rng(0))
+    assert np.bincount(idx, minlength=4).tolist() == [2, 1, 1, 0]
+
+
+def test_bad_params_rejected() -> None:
+    with pytest.raises(ValueError, match="rho"):
+        FilterParams(rho=-1.0)
