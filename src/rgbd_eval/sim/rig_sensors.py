@@ -143,6 +143,17 @@ class StaticDepthConfig(RigSensorConfig):
     random_dropout: float = Field(0.0, ge=0.0, le=1.0, description="P(invalid) anywhere")
 
 
+def pinhole_from_fov(
+    width: int, height: int, hfov_deg: float, vfov_deg: float, frame_id: str
+) -> CameraModel:
+    """An undistorted camera with the given fields of view, principal point at the centre."""
+    fx = (width / 2.0) / math.tan(math.radians(hfov_deg) / 2.0)
+    fy = (height / 2.0) / math.tan(math.radians(vfov_deg) / 2.0)
+    return CameraModel(
+        width, height, fx, fy, (width - 1) / 2.0, (height - 1) / 2.0, (0.0,) * 5, frame_id
+    )
+
+
 class StaticDepthCamera:
     """Writes ``/<name>/depth/image_raw`` (16UC1) and ``/<name>/depth/camera_info``."""
 
@@ -150,12 +161,9 @@ class StaticDepthCamera:
         self.cfg = config
         self.world_frame = world_frame
         c = config
-        fx = (c.width / 2.0) / math.tan(math.radians(c.hfov_deg) / 2.0)
-        fy = (c.height / 2.0) / math.tan(math.radians(c.vfov_deg) / 2.0)
-        self.camera = CameraModel(
-            c.width, c.height, fx, fy, (c.width - 1) / 2.0, (c.height - 1) / 2.0,
-            (0.0,) * 5, f"{c.name}_optical_frame",
-        )  # fmt: skip
+        self.camera = pinhole_from_fov(
+            c.width, c.height, c.hfov_deg, c.vfov_deg, f"{c.name}_optical_frame"
+        )
         body = np.eye(4)
         body[:3, :3] = rotation_z(math.radians(c.yaw_deg)) @ rotation_y(math.radians(c.pitch_deg))
         body[:3, 3] = (c.x, c.y, c.z)

@@ -19,7 +19,6 @@ tf ``<colour optical frame> -> <name>_optical_frame`` in ``/tf_static``.
 
 from __future__ import annotations
 
-import math
 from typing import TYPE_CHECKING, Literal
 
 import numpy as np
@@ -28,8 +27,14 @@ from pydantic import Field
 from scipy import ndimage
 
 from rgbd_eval.sim.meshes import MAT_FLOOR, MAT_SKIN
-from rgbd_eval.sim.rig_sensors import RigSensorConfig, RigSensorSpec, SceneView, register_rig_sensor
-from rgbd_eval.types import CameraModel, Pose
+from rgbd_eval.sim.rig_sensors import (
+    RigSensorConfig,
+    RigSensorSpec,
+    SceneView,
+    pinhole_from_fov,
+    register_rig_sensor,
+)
+from rgbd_eval.types import Pose
 
 if TYPE_CHECKING:
     from rgbd_eval.io.writer import RecordingWriter
@@ -90,12 +95,9 @@ class ThermalCamera:
         self.cfg = config
         self.world_frame = world_frame
         c = config
-        fx = (c.width / 2.0) / math.tan(math.radians(c.hfov_deg) / 2.0)
-        fy = (c.height / 2.0) / math.tan(math.radians(c.vfov_deg) / 2.0)
-        self.camera = CameraModel(
-            c.width, c.height, fx, fy, (c.width - 1) / 2.0, (c.height - 1) / 2.0,
-            (0.0,) * 5, f"{c.name}_optical_frame",
-        )  # fmt: skip
+        self.camera = pinhole_from_fov(
+            c.width, c.height, c.hfov_deg, c.vfov_deg, f"{c.name}_optical_frame"
+        )
         #: colour_optical_T_thermal_optical (parallel axes)
         self.offset = Pose((c.baseline_m, c.offset_y_m, 0.0))
 
