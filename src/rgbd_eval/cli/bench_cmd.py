@@ -10,6 +10,8 @@ import typer
 from rich.table import Table
 
 from rgbd_eval.cli.common import (
+    ConfigOption,
+    SetOption,
     TopicOption,
     advance_callback,
     console,
@@ -100,10 +102,8 @@ def bench(
         str | None, typer.Option(help="method by name (`rgbd-eval methods`; default: basso2012)")
     ] = None,
     repeat: Annotated[int, typer.Option(help="repeats; figures are medians")] = 3,
-    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
-    overrides: Annotated[
-        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
-    ] = None,
+    config_file: ConfigOption = None,
+    overrides: SetOption = None,
     json_out: Annotated[
         bool, typer.Option("--json", help="print the result as JSON instead of a table")
     ] = False,

@@ -12,6 +12,8 @@ from rich.table import Table
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
+    ConfigOption,
+    SetOption,
     TopicOption,
     advance_callback,
     console,
@@ -110,10 +112,8 @@ def run(
     threshold: Annotated[
         float | None, typer.Option(help="IoU >= x, or distance <= x metres")
     ] = None,
-    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
-    overrides: Annotated[
-        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
-    ] = None,
+    config_file: ConfigOption = None,
+    overrides: SetOption = None,
     out: Annotated[
         Path | None, typer.Option(help="output folder (default: runs/<time>-<method>)")
     ] = None,

@@ -10,7 +10,7 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import CLUSTER_HELP, console, handle_errors
+from rgbd_eval.cli.common import CLUSTER_HELP, ConfigOption, SetOption, console, handle_errors
 from rgbd_eval.config import load_config
 from rgbd_eval.errors import ConfigError
 
@@ -43,10 +43,8 @@ def score(
     tracks_topic: Annotated[
         str | None, typer.Option(help="topic of the tracks in a bag (when there are several)")
     ] = None,
-    config_file: Annotated[Path | None, typer.Option("--config", help="YAML run config")] = None,
-    overrides: Annotated[
-        list[str] | None, typer.Option("--set", help="KEY=VALUE override, repeatable")
-    ] = None,
+    config_file: ConfigOption = None,
+    overrides: SetOption = None,
     out: Annotated[
         Path | None, typer.Option(help="output folder (default: runs/<time>-score)")
     ] = None,
