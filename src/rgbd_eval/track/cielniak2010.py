@@ -40,6 +40,7 @@ from pydantic import Field
 
 from rgbd_eval.config import ComponentConfig
 from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
+from rgbd_eval.track.occlusion import order, overlap
 from rgbd_eval.track.person_geometry import HeightPrior, height_log_prior, implied_heights
 from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores
 from rgbd_eval.track.thermal_pf import (
@@ -87,6 +88,9 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     confirm_frames: int = Field(3, ge=1)
     stop_score: float = Field(1.5, ge=0.0, description="K below which a filter is losing")
     lost_frames: int = Field(10, ge=1)
+    occlusion_handling: bool = Field(False, description="section 6: order overlapping persons")
+    occlusion_overlap: float = Field(0.3, gt=0.0, le=1.0, description="over the smaller box")
+    max_occluded_frames: int = Field(60, ge=1, description="an occluded filter coasts this long")
     alignment_depth_m: float = Field(3.0, gt=0.0, description="nominal depth of the affine map")
     seed: int = Field(0, ge=0)
 
@@ -121,6 +125,7 @@ class _Track:
     filter: ThermalParticleFilter
     score: float = 0.0
     weak_frames: int = 0
+    occluded_frames: int = 0
 
 
 @dataclass(frozen=True)
@@ -183,7 +188,7 @@ class Cielniak2010Tracker:
         dt = 1.0 / 30.0 if self.last_stamp is None else max(stamp_ns - self.last_stamp, 0) / 1e9
         self.last_stamp = stamp_ns
         t1 = time.perf_counter()
-        self._track(temp, thermal, dt)
+        self._track(temp, thermal, frame.streams.get("colour"), dt)
         t2 = time.perf_counter()
         regions = warm_regions(temp, self.warm)
         self._detect(temp, thermal, regions)
@@ -207,12 +212,43 @@ class Cielniak2010Tracker:
             ll = ll + height_log_prior(self.height_prior, heights)
         return ll
 
-    def _track(self, temp: NDArray[np.float32], thermal: Stream, dt: float) -> None:
+    def _occluded(self, temp: NDArray[np.float32], colour: Stream | None) -> set[int]:
+        """Indices of the filters behind another one (section 6), by pairwise :func:`order`."""
+        if not self.cfg.occlusion_handling:
+            return set()
+        boxes = [t.filter.box() for t in self.tracks]
+        image = None if colour is None else colour.image
+        behind = set()
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                if overlap(boxes[i], boxes[j]) >= self.cfg.occlusion_overlap:
+                    front = order(boxes[i], boxes[j], temp, image)
+                    behind.add(j if front == 0 else i)
+        return behind
+
+    def _track(
+        self, temp: NDArray[np.float32], thermal: Stream, colour: Stream | None, dt: float
+    ) -> None:
+        """Step every filter. An occluded filter (section 6) coasts on its motion model and
+        neither penalises nor is penalised by the others; its occluder tracks as usual."""
         H, W = temp.shape
+        behind = self._occluded(temp, colour)
         kept = []
         for i, t in enumerate(self.tracks):
+            if i in behind:
+                t.filter.predict(dt)
+                t.filter.estimate = t.filter.particles.mean(axis=0)
+                t.occluded_frames += 1
+                est = t.filter.estimate
+                inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
+                if inside and t.occluded_frames <= self.cfg.max_occluded_frames:
+                    kept.append(t)
+                continue
+            t.occluded_frames = 0
             others: list[Neighbour] = [
-                (o.filter.box(), self.cfg.rho) for j, o in enumerate(self.tracks) if j != i
+                (o.filter.box(), self.cfg.rho)
+                for j, o in enumerate(self.tracks)
+                if j != i and j not in behind
             ]
             t.filter.step(lambda x: self._loglik(temp, thermal, x), dt, others)
             est = t.filter.estimate
@@ -298,9 +334,8 @@ class Cielniak2010Tracker:
             own = self._reported_box(box, float(t.filter.estimate[2]), regions, boxes)
             u0, v0, u1, v1 = (float(x) for x in own)
             x, y = _ground_point(thermal, (u0 + u1) / 2.0, v1)
-            out.append(
-                TrackOutput(t.track_id, x, y, 0.0, affine.box(u0, v0, u1, v1), Visibility.VISIBLE)
-            )
+            seen = Visibility.OCCLUDED if t.occluded_frames else Visibility.VISIBLE
+            out.append(TrackOutput(t.track_id, x, y, 0.0, affine.box(u0, v0, u1, v1), seen))
         return out
 
 
