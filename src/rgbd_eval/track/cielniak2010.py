@@ -252,7 +252,9 @@ class Cielniak2010Tracker:
             ]
             t.filter.step(lambda x: self._loglik(temp, thermal, x), dt, others)
             est = t.filter.estimate
-            t.score = float(silhouette_scores(temp, self.silhouette, est[None, :], self.contrast)[0])
+            t.score = float(
+                silhouette_scores(temp, self.silhouette, est[None, :], self.contrast)[0]
+            )
             t.weak_frames = t.weak_frames + 1 if t.score < self.cfg.stop_score else 0
             inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
             if inside and t.weak_frames < self.cfg.lost_frames:
@@ -266,7 +268,9 @@ class Cielniak2010Tracker:
         aspect = (self.params.min_aspect, self.params.max_aspect)
         fresh: list[F64] = []
         for box in boxes:
-            if any(box_iou(box[None, :], tb, of_smaller=True)[0] > _TRACKED_OVERLAP for tb in tracked):
+            if any(
+                box_iou(box[None, :], tb, of_smaller=True)[0] > _TRACKED_OVERLAP for tb in tracked
+            ):
                 continue
             state = _state_of_box(box, self.silhouette.width_ratio, aspect)
             score = silhouette_scores(temp, self.silhouette, state[None, :], self.contrast)[0]
@@ -315,9 +319,12 @@ class Cielniak2010Tracker:
         if np.count_nonzero(mine) != 1:
             return box
         k = int(np.argmax(mine))
-        comp = regions.boxes[k]
+        comp: F64 = regions.boxes[k]
         for other in boxes:
-            if other is not box and box_iou(comp[None, :], other, of_smaller=True)[0] >= _TRACKED_OVERLAP:
+            if (
+                other is not box
+                and box_iou(comp[None, :], other, of_smaller=True)[0] >= _TRACKED_OVERLAP
+            ):
                 return box
         if not 0.7 * h <= comp[3] - comp[1] <= 1.4 * h:
             return box

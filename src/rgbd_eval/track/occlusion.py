@@ -30,6 +30,7 @@ def sort_front_to_back(
 ) -> list[int]:
     """Indices of ``boxes`` from front to back by pairwise :func:`order` (M log M comparisons,
     seed 004, section 5)."""
+
     def cmp(i: int, j: int) -> int:
         return -1 if order(boxes[i], boxes[j], thermal, colour) == 0 else 1
 

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 F64 = NDArray[np.float64]
 
+
 @dataclass(frozen=True)
 class Silhouette:
     """Contour points and outward unit normals in units of the silhouette height.
@@ -80,7 +81,9 @@ class ContrastParams:
 
     def __post_init__(self) -> None:
         if self.offset <= 0.0 or self.min_offset_px <= 0.0:
-            raise ValueError(f"offset={self.offset}, min_offset_px={self.min_offset_px} must be > 0")
+            raise ValueError(
+                f"offset={self.offset}, min_offset_px={self.min_offset_px} must be > 0"
+            )
         if self.saturation <= 0.0:
             raise ValueError(f"saturation={self.saturation} must be positive")
 
@@ -99,7 +102,6 @@ def silhouette_scores(
     """
     if states.ndim != 2 or states.shape[1] < 3:
         raise ValueError(f"states shape {states.shape} must be (N, >=3)")
-    H, W = temperature.shape
     u = states[:, 0:1]
     v = states[:, 1:2]
     h = states[:, 2:3]
