@@ -74,6 +74,8 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     rho: float = Field(10.0, ge=0.0, description="interaction: log-likelihood lost at full overlap")
     contrast_offset: float = Field(0.05, gt=0.0, le=0.5, description="share of the height")
     contrast_saturation_k: float = Field(8.0, gt=0.0)
+    surround: float = Field(0.15, gt=0.0, description="share of h outside the contour")
+    surround_weight: float = Field(1.0, ge=0.0, description="K of score per K of warm surround")
     min_height_px: float = Field(20.0, gt=0.0)
     max_height_px: float = Field(400.0, gt=0.0)
     ground_prior: bool = Field(True, description="weigh by the implied standing height")
@@ -88,7 +90,7 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     confirm_frames: int = Field(3, ge=1)
     stop_score: float = Field(1.5, ge=0.0, description="K below which a filter is losing")
     lost_frames: int = Field(10, ge=1)
-    occlusion_handling: bool = Field(False, description="section 6: order overlapping persons")
+    occlusion_handling: bool = Field(True, description="section 6: order overlapping persons")
     occlusion_overlap: float = Field(0.3, gt=0.0, le=1.0, description="over the smaller box")
     max_occluded_frames: int = Field(60, ge=1, description="an occluded filter coasts this long")
     alignment_depth_m: float = Field(3.0, gt=0.0, description="nominal depth of the affine map")
@@ -165,7 +167,12 @@ class Cielniak2010Tracker:
             min_height=c.min_height_px,
             max_height=c.max_height_px,
         )
-        self.contrast = ContrastParams(c.contrast_offset, saturation=c.contrast_saturation_k)
+        self.contrast = ContrastParams(
+            c.contrast_offset,
+            saturation=c.contrast_saturation_k,
+            surround=c.surround,
+            surround_weight=c.surround_weight,
+        )
         self.height_prior = HeightPrior(c.person_min_m, c.person_max_m, c.person_sigma_m)
         self.warm = WarmRegionParams(
             c.warm_contrast_k, c.warm_max_c, c.min_height_px, c.warm_elongation, c.warm_fill
