@@ -29,6 +29,7 @@ images), computed once from the two CameraInfos and the tf between the cameras.
 
 from __future__ import annotations
 
+import functools
 import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -40,9 +41,15 @@ from pydantic import Field
 
 from rgbd_eval.config import ComponentConfig
 from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
+from rgbd_eval.track.colour_moments import (
+    ColourModel,
+    IntegralMoments,
+    moment_distances,
+    person_moments_many,
+)
 from rgbd_eval.track.occlusion import order, overlap
 from rgbd_eval.track.person_geometry import HeightPrior, height_log_prior, implied_heights
-from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores
+from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores, state_boxes
 from rgbd_eval.track.thermal_pf import (
     F64,
     FilterParams,
@@ -93,6 +100,14 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     occlusion_handling: bool = Field(True, description="section 6: order overlapping persons")
     occlusion_overlap: float = Field(0.3, gt=0.0, le=1.0, description="over the smaller box")
     max_occluded_frames: int = Field(60, ge=1, description="an occluded filter coasts this long")
+    colour: bool = Field(True, description="section 4: colour moments in the likelihood")
+    colour_scale: float = Field(20.0, gt=0.0, description="moment distance per log-likelihood")
+    colour_alpha: float = Field(0.05, ge=0.0, le=1.0, description="adaptive update rate")
+    colour_stride: int = Field(2, ge=1, le=16, description="colour image subsampling")
+    reid_distance: float = Field(
+        40.0, ge=0.0, description="section 6: moment distance to re-use an id"
+    )
+    reid_memory_frames: int = Field(150, ge=0, description="how long a lost person is remembered")
     alignment_depth_m: float = Field(3.0, gt=0.0, description="nominal depth of the affine map")
     seed: int = Field(0, ge=0)
 
@@ -125,9 +140,17 @@ class Affine:
 class _Track:
     track_id: int
     filter: ThermalParticleFilter
+    colour: ColourModel | None = None
     score: float = 0.0
     weak_frames: int = 0
     occluded_frames: int = 0
+
+
+@dataclass(frozen=True)
+class _Lost:
+    track_id: int
+    colour: ColourModel
+    frame: int
 
 
 @dataclass(frozen=True)
@@ -179,6 +202,9 @@ class Cielniak2010Tracker:
         )
         self.tracks: list[_Track] = []
         self.proposals: list[_Proposal] = []
+        self.lost: list[_Lost] = []
+        self.frame_index = 0
+        self.integral: IntegralMoments | None = None
         self.next_id = 1
         self.last_stamp: int | None = None
         self.affine: Affine | None = None
@@ -192,6 +218,14 @@ class Cielniak2010Tracker:
         t0 = time.perf_counter()
         thermal = frame.stream("thermal")
         temp = temperature_image(thermal)
+        colour = frame.streams.get("colour")
+        if colour is not None and self.affine is None:
+            self.affine = Affine.between(thermal, colour, self.cfg.alignment_depth_m)
+        self.integral = None
+        if self.cfg.colour and colour is not None and colour.image.ndim == 3:
+            k = self.cfg.colour_stride
+            self.integral = IntegralMoments.of(colour.image[::k, ::k])
+        self.frame_index += 1
         dt = 1.0 / 30.0 if self.last_stamp is None else max(stamp_ns - self.last_stamp, 0) / 1e9
         self.last_stamp = stamp_ns
         t1 = time.perf_counter()
@@ -209,14 +243,43 @@ class Cielniak2010Tracker:
         }
         return out
 
-    def _loglik(self, temp: NDArray[np.float32], thermal: Stream, states: F64) -> F64:
-        """Thermal contrast over its scale, plus the standing-height log-prior."""
+    def _observe(self, states: F64) -> F64:
+        """``(N, R, 3, C)`` colour moments of the body regions of N states (section 4)."""
+        if self.integral is None or self.affine is None:
+            raise ValueError("no colour image to observe")
+        (sx, sy), (ox, oy) = self.affine.scale, self.affine.offset
+        k = float(self.cfg.colour_stride)
+        b = state_boxes(states, self.silhouette.width_ratio)
+        colour_boxes = np.stack(
+            [(sx * b[:, 0] + ox) / k, (sy * b[:, 1] + oy) / k, (sx * b[:, 2] + ox) / k,
+             (sy * b[:, 3] + oy) / k],
+            axis=1,
+        )  # fmt: skip
+        return person_moments_many(self.integral, colour_boxes)
+
+    def _colour_distances(self, model: ColourModel, states: F64) -> F64:
+        d = moment_distances(model.moments, self._observe(states))
+        out: F64 = np.where(np.isfinite(d), d, 0.0)  # nothing measured: no evidence
+        return out
+
+    def _loglik(
+        self,
+        temp: NDArray[np.float32],
+        thermal: Stream,
+        states: F64,
+        *,
+        model: ColourModel | None,
+    ) -> F64:
+        """Thermal contrast over its scale, plus the standing-height log-prior, minus the colour
+        moments' distance to the person's model over its scale (section 4)."""
         ll: F64 = silhouette_scores(temp, self.silhouette, states, self.contrast) / (
             self.cfg.score_scale
         )
         if self.cfg.ground_prior:
             heights = implied_heights(thermal.camera, thermal.pose, states)
             ll = ll + height_log_prior(self.height_prior, heights)
+        if model is not None and self.integral is not None:
+            ll = ll - self._colour_distances(model, states) / self.cfg.colour_scale
         return ll
 
     def _occluded(self, temp: NDArray[np.float32], colour: Stream | None) -> set[int]:
@@ -250,6 +313,8 @@ class Cielniak2010Tracker:
                 inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
                 if inside and t.occluded_frames <= self.cfg.max_occluded_frames:
                     kept.append(t)
+                else:
+                    self._forget(t)
                 continue
             t.occluded_frames = 0
             others: list[Neighbour] = [
@@ -257,7 +322,9 @@ class Cielniak2010Tracker:
                 for j, o in enumerate(self.tracks)
                 if j != i and j not in behind
             ]
-            t.filter.step(lambda x: self._loglik(temp, thermal, x), dt, others)
+            t.filter.step(
+                functools.partial(self._loglik, temp, thermal, model=t.colour), dt, others
+            )
             est = t.filter.estimate
             t.score = float(
                 silhouette_scores(temp, self.silhouette, est[None, :], self.contrast)[0]
@@ -266,7 +333,37 @@ class Cielniak2010Tracker:
             inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
             if inside and t.weak_frames < self.cfg.lost_frames:
                 kept.append(t)
+            else:
+                self._forget(t)
         self.tracks = kept
+        self._adapt_colour()
+
+    def _forget(self, track: _Track) -> None:
+        """Remember a deleted person's colour for re-identification (section 6)."""
+        if track.colour is not None and self.cfg.reid_memory_frames > 0:
+            self.lost.append(_Lost(track.track_id, track.colour, self.frame_index))
+
+    def _adapt_colour(self) -> None:
+        """Blend each clearly seen person's colour moments into its model (section 4): a
+        filter scoring at least ``start_score`` and overlapping no other filter."""
+        if self.integral is None:
+            return
+        boxes = [t.filter.box() for t in self.tracks]
+        for i, t in enumerate(self.tracks):
+            if t.occluded_frames or t.score < self.cfg.start_score:
+                continue
+            if any(
+                overlap(boxes[i], b) >= self.cfg.occlusion_overlap
+                for j, b in enumerate(boxes)
+                if j != i
+            ):
+                continue
+            seen = self._observe(t.filter.estimate[None, :])[0]
+            t.colour = (
+                ColourModel(seen)
+                if t.colour is None
+                else t.colour.updated(seen, self.cfg.colour_alpha)
+            )
 
     def _detect(self, temp: NDArray[np.float32], thermal: Stream, regions: WarmRegions) -> None:
         c = self.cfg
@@ -312,10 +409,25 @@ class Cielniak2010Tracker:
         return np.array([state[0] - w / 2, state[1] - h / 2, state[0] + w / 2, state[1] + h / 2])
 
     def _start(self, state: F64) -> None:
+        """A filter on a confirmed proposal; it takes the id of a recently lost person whose
+        colour moments are within ``reid_distance`` (section 6), else a new id."""
         f = ThermalParticleFilter.around(self.params, self.silhouette, state, 0.05, self.rng)
         f.estimate = state.copy()
-        self.tracks.append(_Track(self.next_id, f))
-        self.next_id += 1
+        recent = self.frame_index - self.cfg.reid_memory_frames
+        self.lost = [lost for lost in self.lost if lost.frame >= recent]
+        model = None
+        track_id = self.next_id
+        if self.integral is not None:
+            seen = self._observe(state[None, :])
+            model = ColourModel(seen[0])
+            if self.lost:
+                d = [float(moment_distances(lost.colour.moments, seen)[0]) for lost in self.lost]
+                best = int(np.argmin(d))
+                if d[best] <= self.cfg.reid_distance:
+                    track_id = self.lost.pop(best).track_id
+        if track_id == self.next_id:
+            self.next_id += 1
+        self.tracks.append(_Track(track_id, f, colour=model))
 
     def _reported_box(self, box: F64, h: float, regions: WarmRegions, boxes: list[F64]) -> F64:
         """The warm component that overlaps this filter's box and no other filter's, when
@@ -338,9 +450,6 @@ class Cielniak2010Tracker:
         return comp
 
     def _outputs(self, frame: Frame, thermal: Stream, regions: WarmRegions) -> list[TrackOutput]:
-        colour = frame.streams.get("colour")
-        if colour is not None and self.affine is None:
-            self.affine = Affine.between(thermal, colour, self.cfg.alignment_depth_m)
         affine = self.affine or Affine((1.0, 1.0), (0.0, 0.0))
         out = []
         boxes = [t.filter.box() for t in self.tracks]
