@@ -94,3 +94,93 @@ def test_stand_in_order_puts_the_lower_feet_in_front() -> None:
     assert sort_front_to_back([far, near, far + 1.0], thermal, None) == [1, 2, 0]
     # overlap over the smaller box: intersection 20 x 90 = 1800, smaller 30 x 90 = 2700
     assert overlap(near, far) == pytest.approx(1800 / 2700)
+
+
+#: A level camera 1.1 m above the floor (optical z = world x, optical y = -world z).
+LEVEL = Pose((0.0, 0.0, 1.1), (-0.5, 0.5, -0.5, 0.5))
+
+
+def _people_image(us: list[float]) -> np.ndarray:
+    """20 C room, 28 C people 1.75 m tall 5 m away (h = 105 px, centre v = 133, see
+    test_implied_height...) at columns ``us``: head, torso and legs ellipses."""
+    H, W = 240, 320
+    yy, xx = np.mgrid[0:H, 0:W].astype(np.float64)
+    img = np.full((H, W), 20.0)
+    h, v = 105.0, 133.0
+    for u in us:
+        inside = np.zeros((H, W), dtype=bool)
+        for cy, a, b in ((-0.435, 0.05, 0.065), (-0.175, 0.13, 0.195), (0.26, 0.09, 0.24)):
+            inside |= ((xx - u) / (a * h)) ** 2 + ((yy - (v + cy * h)) / (b * h)) ** 2 <= 1
+        img[inside] = 28.0
+    return img
+
+
+def _level_frame(i: int, temp_c: np.ndarray) -> Frame:
+    counts = np.rint((temp_c + 273.15) * 100).astype(np.uint16)
+    stamp = i * 33_333_333
+    return Frame(i, stamp, {"thermal": Stream(counts, "mono16", THERMAL, stamp, LEVEL)})
+
+
+def test_sequential_detector_starts_one_filter_per_person_and_deletes_lost_ones() -> None:
+    trk = Cielniak2010Tracker(Cielniak2010TrackerConfig(), DetectionContract())
+    two = _people_image([100.0, 220.0])
+    # confirm_frames = 3: the proposals of frames 0 and 1 are pending, frame 2 starts both
+    counts = [len(trk.update(i * 33_333_333, [], _level_frame(i, two))) for i in range(3)]
+    assert counts == [0, 0, 2]
+    for i in range(3, 20):
+        out = trk.update(i * 33_333_333, [], _level_frame(i, two))
+    assert sorted(t.track_id for t in out) == [1, 2]
+    by_id = {t.track_id: t.box2d for t in out}
+    # without a colour stream the boxes stay in thermal pixels: the warm components' boxes
+    # (the blobs' extents: 105 px tall, the torso 2 * 0.13 * 105 = 27 px wide)
+    for box, u in zip((by_id[1], by_id[2]), (100.0, 220.0), strict=True):
+        assert abs(box.left + box.width / 2 - u) <= 1.0 and abs(box.height - 105.0) <= 2.0
+    # the person at u = 220 leaves: its filter scores below stop_score and goes after
+    # lost_frames = 10 frames; the other keeps its id
+    one = _people_image([100.0])
+    alive = []
+    for i in range(20, 32):
+        alive.append(
+            sorted(t.track_id for t in trk.update(i * 33_333_333, [], _level_frame(i, one)))
+        )
+    assert alive[0] == [1, 2] and alive[-1] == [1]
+
+
+def _dressed_frame(i: int, u: float | None, rgb: tuple[int, int, int]) -> Frame:
+    """A thermal frame with a person at column ``u`` (none when None) and a colour frame, same
+    pose (affine: scale 525 / 300 = 1.75, offset 319.5 - 1.75 * 159.5 = 40.375 and
+    239.5 - 1.75 * 119.5 = 30.375), where the person's thermal box is painted ``rgb``."""
+    temp = _people_image([] if u is None else [u])
+    colour = np.full((480, 640, 3), 128, np.uint8)
+    if u is not None:
+        u0, u1 = 1.75 * (u - 20.0) + 40.375, 1.75 * (u + 20.0) + 40.375
+        v0, v1 = 1.75 * 80.0 + 30.375, 1.75 * 186.0 + 30.375
+        colour[round(v0) : round(v1), round(u0) : round(u1)] = rgb
+    counts = np.rint((temp + 273.15) * 100).astype(np.uint16)
+    stamp = i * 33_333_333
+    return Frame(
+        i,
+        stamp,
+        {
+            "thermal": Stream(counts, "mono16", THERMAL, stamp, LEVEL),
+            "colour": Stream(colour, "rgb8", COLOUR, stamp, LEVEL),
+        },
+    )
+
+
+@pytest.mark.parametrize(("again", "same_id"), [((200, 30, 30), True), ((30, 30, 200), False)])
+def test_a_lost_person_is_reidentified_by_colour(
+    again: tuple[int, int, int], same_id: bool
+) -> None:
+    trk = Cielniak2010Tracker(Cielniak2010TrackerConfig(), DetectionContract())
+    for i in range(15):  # a red-clad person at u = 100
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, 100.0, (200, 30, 30)))
+    assert [t.track_id for t in out] == [1]
+    for i in range(15, 30):  # gone: deleted after lost_frames = 10
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, None, (0, 0, 0)))
+    assert out == []
+    for i in range(30, 40):  # someone appears elsewhere: red again, or blue
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, 180.0, again))
+    # red: the same paint in the same body regions, the moments match (below reid_distance): id 1;
+    # blue: the means differ by 170 in two channels, far beyond reid_distance: a new id
+    assert [t.track_id for t in out] == ([1] if same_id else [2])
