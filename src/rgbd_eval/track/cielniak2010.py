@@ -292,7 +292,7 @@ class Cielniak2010Tracker:
         for i in range(len(boxes)):
             for j in range(i + 1, len(boxes)):
                 if overlap(boxes[i], boxes[j]) >= self.cfg.occlusion_overlap:
-                    front = order(boxes[i], boxes[j], temp, image)
+                    front = order(boxes[i], boxes[j], temp, image, self.affine)
                     behind.add(j if front == 0 else i)
         return behind
 
