@@ -104,9 +104,8 @@ def silhouette_scores(
     """Mean inward-minus-outward temperature (K) along the contour of each state ``(u, v, h, ...)``.
 
     A sixth column, when present, is the width factor ``a`` (the silhouette's widths are
-    scaled by it: about 1 for a person seen from the front, 0.6-0.7 in profile). The means
-    are over the contour points measured inside the image, but over at least half of all
-    points, so that a person leaving the image keeps its score while half of it is in view.
+    scaled by it: about 1 for a person seen from the front, 0.6-0.7 in profile). A contour
+    point whose inner or outer sample falls outside the image scores 0 (nothing is measured).
     """
     if states.ndim != 2 or states.shape[1] < 3:
         raise ValueError(f"states shape {states.shape} must be (N, >=3)")
@@ -120,10 +119,8 @@ def silhouette_scores(
     nx, ny = silhouette.normals[:, 0] * d, silhouette.normals[:, 1] * d
     t_in, ok_in = _sample(temperature, x - nx, y - ny)
     t_out, ok_out = _sample(temperature, x + nx, y + ny)
-    ok = ok_in & ok_out
-    point = np.where(ok, np.clip(t_in - t_out, 0.0, params.saturation), 0.0)
-    least = 0.5 * point.shape[1]
-    out: F64 = point.sum(axis=1) / np.maximum(ok.sum(axis=1), least)
+    point = np.where(ok_in & ok_out, np.clip(t_in - t_out, 0.0, params.saturation), 0.0)
+    out: F64 = point.mean(axis=1).astype(np.float64)
     if params.surround_weight > 0.0:
         room = float(np.median(temperature[::4, ::4]))
         ds = params.surround * h
@@ -131,9 +128,7 @@ def silhouette_scores(
             temperature, x + silhouette.normals[:, 0] * ds, y + silhouette.normals[:, 1] * ds
         )
         warm = np.where(ok_far, np.clip(t_far - room, 0.0, params.saturation), 0.0)
-        out = out - params.surround_weight * warm.sum(axis=1) / np.maximum(
-            ok_far.sum(axis=1), least
-        )
+        out = out - params.surround_weight * warm.mean(axis=1)
     return out
 
 
