@@ -12,14 +12,23 @@ Per frame:
    the log-likelihood ``score / score_scale + log p(height)``: the silhouette's thermal
    contrast (:mod:`rgbd_eval.track.silhouette`, K) and the plausibility of the standing
    height the silhouette implies on the floor (:mod:`rgbd_eval.track.person_geometry`,
-   our addition), with the interaction ``rho`` towards the other filters' estimates.
+   our addition), minus the distance of the colour moments of its head, torso and legs
+   to the person's adaptive colour model over ``colour_scale`` (section 4; the colour
+   image is aligned by the affine map below), with the interaction ``rho`` towards the
+   other filters' estimates. A filter behind another one (section 6: pairwise
+   :func:`rgbd_eval.track.occlusion.order`, overlap of the boxes at least
+   ``occlusion_overlap``) coasts on its motion model, and neither penalises nor is
+   penalised by the others, for at most ``max_occluded_frames``.
 2. A filter whose estimate scores below ``stop_score`` for ``lost_frames`` frames in a
-   row, or whose centre leaves the image, is deleted.
+   row, or whose centre leaves the image, is deleted; its colour model is remembered
+   ``reid_memory_frames`` for re-identification (section 6). The colour model of a filter
+   seen clearly (score at least ``start_score``, no overlap) adapts at rate ``colour_alpha``.
 3. The sequential detector proposes person-shaped warm regions
    (:mod:`rgbd_eval.track.warm_regions`) away from the tracked persons; a proposal that
    scores at least ``start_score`` and implies a standing height within the prior's
    range, and is seen again (IoU >= 0.3) in ``confirm_frames`` consecutive frames,
-   starts a filter.
+   starts a filter, with the id of a remembered person whose colour moments lie within
+   ``reid_distance``, else a new one.
 
 Boxes are mapped from the thermal to the colour image, where the ground truth lives, by
 the affine transform of parallel cameras at a nominal depth (seed 004, section 4.1: the
