@@ -49,6 +49,10 @@ READ_ERRORS: tuple[type[BaseException], ...] = (
     sqlite3.Error,
 )
 
+#: Exceptions of deserialising one message whose bytes do not match its definition
+#: (rosbags wraps struct/unicode/size errors in SerdeError; an unknown type is ValueError).
+MESSAGE_ERRORS: tuple[type[BaseException], ...] = (SerdeError, ValueError)
+
 
 @dataclass(frozen=True)
 class TopicConnection:
@@ -115,6 +119,8 @@ class AnyReaderSource(MessageSource):
             return self._reader.deserialize(bytes(raw), msgtype)
         except KeyError as err:  # a damaged type table names a type the typestore lacks
             raise ValueError(f"message type {msgtype!r} has no definition") from err
+        except AnyReaderError as err:  # AnyReader wraps the SerdeError of one message
+            raise SerdeError(str(err)) from err
 
     def close(self) -> None:
         self._reader.close()
