@@ -673,7 +673,43 @@ def _score_cases() -> list[Case]:
         (root / "out" / "notes.txt").write_text("mine\n")
         return root / "out"
 
+    def tracks_file(name: str, data: bytes) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / name).write_bytes(data)
+            (root / "gt.txt").write_text(MOT_GT)
+            return [
+                "score",
+                str(root / name),
+                "--gt",
+                str(root / "gt.txt"),
+                "--out",
+                str(root / "o"),
+            ]
+
+        return build
+
+    def tracks_fifo(root: Path) -> list[str]:
+        os.mkfifo(root / "tracks.txt")
+        (root / "gt.txt").write_text(MOT_GT)
+        return ["score", str(root / "tracks.txt"), "--gt", str(root / "gt.txt")]
+
+    header = b"frame,id,bb_left,bb_top,bb_width,bb_height,x,y,z,stamp_ns\n"
     return [
+        Case(
+            "score_tracks_csv_short_row",
+            "TRACEBACK",
+            tracks_file("t.csv", header + b"1,7,0,0\n"),
+            3,
+            "fewer fields",
+        ),
+        Case(
+            "score_tracks_csv_bad_frame",
+            "TRACEBACK",
+            tracks_file("t.csv", header + b"x,7,0,0,10,10,1,1,1,0\n"),
+            3,
+            "line 2",
+        ),
+        Case("score_tracks_fifo", "HANG", tracks_fifo, 3, "named pipe"),
         Case("score_out_is_file", "TRACEBACK", score_into(a_file), 7, "not a folder"),
         Case("score_out_foreign_folder", "DATA-LOSS", score_into(foreign), 7, "--force"),
         # The output problem is found first: the broken tracks file is never read.
@@ -698,7 +734,69 @@ def _model_and_cache_cases() -> list[Case]:
             str(root / "out"),
         ]
 
-    return [Case("onnx_model_not_a_model", "TRACEBACK", not_a_model, 4, "cannot be loaded")]
+    def det_txt(data: bytes | None) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            det = root / "det.txt"
+            if data is None:
+                os.mkfifo(det)
+            else:
+                det.write_bytes(data)
+            return [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "pinto2022",
+                "--set",
+                "detector.person.backend=recorded",
+                "--set",
+                f"detector.person.source={det}",
+                "--out",
+                str(root / "out"),
+            ]
+
+        return build
+
+    def calibration(data: bytes | None) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            calib = root / "calib.yaml"
+            if data is None:
+                os.mkfifo(calib)
+            else:
+                calib.write_bytes(data)
+            return [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "dmtbs",
+                "--set",
+                f"detector.calibration={calib}",
+                "--out",
+                str(root / "out"),
+            ]
+
+        return build
+
+    latin = "1,-1,0,0,10,10,0.9\n# caf\xe9\n".encode("latin-1")
+    return [
+        Case("onnx_model_not_a_model", "TRACEBACK", not_a_model, 4, "cannot be loaded"),
+        Case("det_txt_latin1", "TRACEBACK", det_txt(latin), 3, "not UTF-8"),
+        Case("det_txt_fifo", "HANG", det_txt(None), 3, "named pipe"),
+        Case(
+            "calibration_latin1",
+            "TRACEBACK",
+            calibration("a: caf\xe9\n".encode("latin-1")),
+            4,
+            "not UTF-8",
+        ),
+        Case("calibration_fifo", "HANG", calibration(None), 4, "named pipe"),
+        Case(
+            "calibration_dup_key",
+            "SILENT",
+            calibration(b"cameras: {}\ncameras: {}\n"),
+            4,
+            "duplicate",
+        ),
+    ]
 
 
 def all_cases() -> list[Case]:

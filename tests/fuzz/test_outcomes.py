@@ -210,3 +210,31 @@ def test_score_force_writes_into_a_foreign_folder_and_keeps_its_files(
     # A re-run replaces what score wrote and still keeps the user's file, without --force.
     assert run_cli([*args, "--out", str(out)], capsys).code == 0
     assert (out / "notes.txt").is_file() and leftovers(tmp_path) == []
+
+
+def test_a_corrupt_npz_cache_entry_is_recomputed_with_one_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = good_recording(tmp_path)
+    cache = tmp_path / "cache"
+    args = ["sweep", "tracker.min_confidence", "-1", "0", "--dataset", str(rec)]
+    args += ["--cache", str(cache), "--cluster", "local:1"]
+    first = run_cli([*args, "--out", str(tmp_path / "s1")], capsys)
+    assert first.code == 0, first.stderr
+    (entry,) = list(cache.rglob("*.det"))  # a header and sha256, then the .npz payload
+    # The .npz lost its last third (its zip central directory), as a full disk leaves it.
+    entry.write_bytes(entry.read_bytes()[: entry.stat().st_size * 2 // 3])
+    second = run_cli([*args, "--out", str(tmp_path / "s2")], capsys)
+    assert second.code == 0, second.stderr
+    assert "Traceback" not in second.stderr
+    warnings = [line for line in second.stderr.splitlines() if line.startswith("warning:")]
+    assert len(warnings) == 1 and "recomputing" in warnings[0], second.stderr
+
+    # The same numbers as from intact detections; the entry is intact again.
+    def counts(folder: str) -> list[dict[str, object]]:  # the records without their timings
+        data = json.loads((tmp_path / folder / "sweep.json").read_text())
+        return [{k: v for k, v in r.items() if "second" not in k} for r in data["records"]]
+
+    assert counts("s1") == counts("s2") and len(counts("s1")) == 2
+    third = run_cli([*args, "--out", str(tmp_path / "s3")], capsys)
+    assert third.code == 0 and "warning:" not in third.stderr
