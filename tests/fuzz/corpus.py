@@ -776,8 +776,18 @@ def _model_and_cache_cases() -> list[Case]:
 
         return build
 
+    def reproduce_into_file(option: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / "file.txt").write_text("mine\n")
+            # Refused before any scenario is generated (that takes minutes).
+            return ["reproduce", "basso2012", option, str(root / "file.txt")]
+
+        return build
+
     latin = "1,-1,0,0,10,10,0.9\n# caf\xe9\n".encode("latin-1")
     return [
+        Case("reproduce_data_is_file", "TRACEBACK", reproduce_into_file("--data"), 7, "--data"),
+        Case("reproduce_out_is_file", "LATE", reproduce_into_file("--out"), 7, "not a folder"),
         Case("onnx_model_not_a_model", "TRACEBACK", not_a_model, 4, "cannot be loaded"),
         Case("det_txt_latin1", "TRACEBACK", det_txt(latin), 3, "not UTF-8"),
         Case("det_txt_fifo", "HANG", det_txt(None), 3, "named pipe"),
