@@ -398,6 +398,22 @@ def _config_cases() -> list[Case]:
         _set_case(
             "threshold_inf", ["evaluation.gating=metric", "evaluation.threshold=.inf"], 4, ""
         ),
+        Case(  # a detector/tracker check was blamed on configs/methods/pinto2022.yaml alone
+            "set_reid_units",
+            "MISLEADING",
+            lambda root: [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "pinto2022",
+                "--set",
+                "detector.reid.backend=mobilenet",
+                "--out",
+                str(root / "out"),
+            ],
+            4,
+            "with --set detector.reid.backend=mobilenet",
+        ),
     ]
 
 

@@ -111,8 +111,13 @@ class AnyReaderSource(MessageSource):
         conns = [c for t, c in self._conns.items() if t in topics]
         if not conns:
             return
-        for conn, log_ns, raw in self._reader.messages(connections=conns):
-            yield conn.topic, log_ns, raw
+        try:
+            for conn, log_ns, raw in self._reader.messages(connections=conns):
+                yield conn.topic, log_ns, raw
+        except AssertionError as err:
+            # rosbags' ROS1 reader asserts that a message record's time equals its index
+            # entry's: a flipped byte in either was an AssertionError traceback.
+            raise Ros1ReaderError("index and message record disagree: the bag is corrupt") from err
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
         try:
