@@ -15,7 +15,8 @@ from tests.io.conftest import Spec, write_recording
 class _Idle:
     """Stands in for the detector: Figure 7.9's timing loop only needs detect()."""
 
-    last_timings: dict[str, float] = {}
+    def __init__(self) -> None:
+        self.last_timings: dict[str, float] = {}
 
     def detect(self, frame: object) -> list[object]:
         return []
