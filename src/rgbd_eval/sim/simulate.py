@@ -152,6 +152,20 @@ class Simulator:
             true, scenario.odometry, _rng(self.seed, _STREAM_ODOMETRY)
         )
 
+    def set_robot_pose(self, index: int, pose: tuple[float, float, float]) -> None:
+        """Closed loop: the robot's true ``(x, y, yaw)`` from frame ``index`` on.
+
+        The odometry is integrated again from the new true path, with the same noise
+        stream, so frames before ``index`` keep their poses and the result depends only
+        on the seed and the poses set.
+        """
+        if not 0 <= index < self.n_frames:
+            raise ValueError(f"index={index} must be in [0, {self.n_frames})")
+        self.true_poses[index:] = pose
+        self.odom_poses = integrate_odometry(
+            self.true_poses, self.scenario.odometry, _rng(self.seed, _STREAM_ODOMETRY)
+        )
+
     @property
     def n_frames(self) -> int:
         return self.scenario.n_frames
