@@ -24,6 +24,7 @@ from __future__ import annotations
 import csv
 import io
 import math
+import time
 from collections.abc import Callable, Sequence
 from contextlib import ExitStack
 from dataclasses import asdict, dataclass, field
@@ -184,6 +185,9 @@ class FollowResult:
     #: The tracks output at every frame (for scoring the run like a recording).
     tracks: tuple[tuple[TrackOutput, ...], ...]
     ground_truth: tuple[tuple[GroundTruthObject, ...], ...]
+    #: CPU seconds of the process (all threads: one core's work) per part of the loop:
+    #: ``render`` (the simulator), ``detect`` and ``track`` (the method), summed over frames.
+    cpu_s: dict[str, float] = field(default_factory=dict)
 
 
 def stereo_pair_of(scenario: Scenario) -> tuple[int, StereoPairConfig]:
@@ -304,6 +308,7 @@ def follow(
     truth: list[tuple[GroundTruthObject, ...]] = []
     locked: int | None = None
     lost = False
+    cpu = {"render": 0.0, "detect": 0.0, "track": 0.0}
     with ExitStack() as stack:
         writer = None
         sensors = [make_rig_sensor(s, rig.WORLD_FRAME) for s in scenario.rig]
@@ -314,8 +319,10 @@ def follow(
             )
             write_static(writer, sim, sensors)
         for i in range(n):
+            c0 = time.process_time()
             f = sim.frame(i)
             images = pair.render_pair(sim.scene_view(i, k_pair))
+            c1 = time.process_time()
             if writer is not None:
                 write_frame(writer, sim, f)
                 for k, sensor in enumerate(sensors):  # each sensor on its own noise stream
@@ -325,7 +332,14 @@ def follow(
                         sensor.write(writer, sim.scene_view(i, k))
             ox, oy, oyaw = (float(v) for v in sim.odom_poses[i])
             frame = _frame(i, f.stamp_ns, images, pair, rig.base_pose(ox, oy, oyaw))
-            tracks = tuple(tracker.update(f.stamp_ns, detector.detect(frame), frame))
+            c2 = time.process_time()
+            detections = detector.detect(frame)
+            c3 = time.process_time()
+            tracks = tuple(tracker.update(f.stamp_ns, detections, frame))
+            c4 = time.process_time()
+            cpu["render"] += c1 - c0
+            cpu["detect"] += c3 - c2
+            cpu["track"] += c4 - c3
             all_tracks.append(tracks)
             truth.append(tuple(f.ground_truth))
             where = next(
@@ -348,7 +362,7 @@ def follow(
     if out_path is not None:
         write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame])
     summary = _summary(scenario, sim.seed, target, steps, c)
-    return FollowResult(tuple(steps), summary, tuple(all_tracks), tuple(truth))
+    return FollowResult(tuple(steps), summary, tuple(all_tracks), tuple(truth), cpu)
 
 
 def _step(

@@ -31,3 +31,27 @@ def test_bad_overrides_and_contradictions_exit_4(tmp_path: Path) -> None:
     clash = runner.invoke(app, ["synth", "demo", "-o", str(tmp_path / "a.mcap"), "--format", "bag"])
     assert clash.exit_code == 4 and "needs a .bag name" in clash.output
     assert not (tmp_path / "a.mcap").exists()
+
+
+def test_rig_stereo_re_renders_a_scenario_through_the_pair(tmp_path: Path) -> None:
+    from rgbd_eval.plugins import StreamSpec
+
+    out = tmp_path / "moving_simple_stereo.mcap"
+    args = ["synth", "moving_simple", "--rig", "stereo", "-o", str(out), "--frames", "1"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    rec = open_recording(out, streams=(StreamSpec("left"), StreamSpec("right")))
+    frame = next(iter(rec.frames()))
+    assert frame.stream("left").image.shape == (384, 512, 3)  # the seed's processed size
+    assert frame.stream("right").camera.tx < 0  # the baseline in the right CameraInfo
+
+
+def test_follow_needs_one_scenario_with_a_stereo_pair(tmp_path: Path) -> None:
+    out = tmp_path / "f.mcap"
+    no_pair = runner.invoke(app, ["synth", "demo", "--follow", "1", "-o", str(out)])
+    assert no_pair.exit_code == 4 and "no stereo_pair" in no_pair.output
+    every = runner.invoke(app, ["synth", "--all", "--follow", "1"])
+    assert every.exit_code == 4 and "not --all" in every.output
+    rig = runner.invoke(app, ["synth", "demo", "--rig", "thermal", "-o", str(out)])
+    assert rig.exit_code == 4 and "expected stereo" in rig.output
+    assert not out.exists()
