@@ -83,7 +83,8 @@ def test_claims_follow_the_thresholds_of_the_paper_yaml() -> None:
         _record("C", 3, 8, 8, 0, A=0, B=0),
     ]
     held = {
-        x.key: x.held for x in check_claims(paper, _result(4, 4, "following", True), good, 55.0)
+        x.key: x.held
+        for x in check_claims(paper, _result(4, 4, "following", True), good, good[0], 55.0)
     }
     assert held == dict.fromkeys(
         (
@@ -100,11 +101,15 @@ def test_claims_follow_the_thresholds_of_the_paper_yaml() -> None:
         _record("B", 2, 7, 7, 0, A=0, C=0),
         _record("C", 3, 8, 8, 0, A=0, B=0),
     ]
-    held = {x.key: x.held for x in check_claims(paper, _result(5, 4, "following", True), bad, 71.0)}
+    held = {
+        x.key: x.held
+        for x in check_claims(paper, _result(5, 4, "following", True), bad, bad[0], 71.0)
+    }
     assert not any(held.values())
     # nobody crossed in front of A: the claim about B and C passing cannot hold
     unseen = [_record("A", 1, 10, 10, 0, B=0, C=2), *good[1:]]
     held = {
-        x.key: x.held for x in check_claims(paper, _result(4, 4, "following", True), unseen, 1.0)
+        x.key: x.held
+        for x in check_claims(paper, _result(4, 4, "following", True), unseen, unseen[0], 1.0)
     }
     assert not held["a_correctly_tracked"] and held["all_tracked_through_occlusions"]
