@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from rgbd_eval.cli.main import app
@@ -55,3 +56,19 @@ def test_follow_needs_one_scenario_with_a_stereo_pair(tmp_path: Path) -> None:
     rig = runner.invoke(app, ["synth", "demo", "--rig", "thermal", "-o", str(out)])
     assert rig.exit_code == 4 and "expected stereo" in rig.output
     assert not out.exists()
+
+
+@pytest.mark.slow
+def test_follow_writes_the_recording_and_the_following_record(tmp_path: Path) -> None:
+    import json
+
+    out = tmp_path / "following.mcap"
+    args = ["synth", "satake2009_following", "--follow", "1", "-o", str(out), "--frames", "3"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    assert "followed person 1" in result.output
+    assert len(open_recording(out)) == 3 and (tmp_path / "following.gt.csv").exists()
+    rows = (tmp_path / "following.follow.csv").read_text().splitlines()
+    assert rows[0].startswith("frame,stamp_ns,t,robot_x") and len(rows) == 4
+    summary = json.loads((tmp_path / "following.follow.json").read_text())
+    assert summary["target"] == 1 and summary["frames"] == 3
