@@ -7,12 +7,19 @@ import math
 import numpy as np
 import pytest
 
-from rgbd_eval.detect.satake2009 import Satake2009DetectorConfig, distance_grid
+from rgbd_eval.detect.satake2009 import (
+    Satake2009Contract,
+    Satake2009DetectorConfig,
+    distance_grid,
+)
 from rgbd_eval.plugins import DetectionContract
 from rgbd_eval.track.satake2009 import Satake2009Tracker, Satake2009TrackerConfig, planar_pose
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, Detection, Frame, Pose, Stream
 
 CAM = CameraModel(64, 48, 40.0, 40.0, 31.5, 23.5)
+CONTRACT = Satake2009Contract(detector=Satake2009DetectorConfig())
+#: These tests feed exact detections to the filter: no template search in the (blank) images.
+NO_SEARCH = {"local_search": False}
 
 
 def _frame(index: int, x: float, y: float, yaw: float) -> Frame:
@@ -36,7 +43,7 @@ def test_a_static_person_stays_put_while_the_robot_drives_and_turns() -> None:
     # The robot drives an arc (0.3 m/s, 0.4 rad/s); a person stands at world (4, 1).
     # Detections are exact, so every output must be (4, 1) with one id; the EKF's
     # prediction in the robot frame must agree with the next detection (no new ids).
-    trk = Satake2009Tracker(Satake2009TrackerConfig(sigma_v=0.05), DetectionContract())
+    trk = Satake2009Tracker(Satake2009TrackerConfig(sigma_v=0.05, **NO_SEARCH), CONTRACT)
     box = Box2D(0, 0, 1, 1)
     for k in range(40):
         t = k * 0.05
@@ -59,8 +66,8 @@ def test_an_unseen_track_is_kept_for_max_missed_s_then_dropped() -> None:
     # 20 fps, max_missed_s = 0.5: seen at frames 0-2, kept (occluded) through frame 12
     # (0.5 s after frame 2), gone at frame 13. With coast_min_hits = 4 it would not be
     # output at all once unseen (3 matches).
-    cfg = Satake2009TrackerConfig(max_missed_s=0.5, coast_min_hits=3)
-    trk = Satake2009Tracker(cfg, DetectionContract())
+    cfg = Satake2009TrackerConfig(max_missed_s=0.5, coast_min_hits=3, **NO_SEARCH)
+    trk = Satake2009Tracker(cfg, CONTRACT)
     det = [Detection((3.0, 0.0, 1.7), 1.7, 1.0, Box2D(0, 0, 1, 1))]
     for k in range(3):
         trk.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
@@ -68,7 +75,7 @@ def test_an_unseen_track_is_kept_for_max_missed_s_then_dropped() -> None:
         out = trk.update(k * 50_000_000, [], _frame(k, 0.0, 0.0, 0.0))
         assert [(o.track_id, o.visibility.name) for o in out] == [(1, "OCCLUDED")]
     assert trk.update(13 * 50_000_000, [], _frame(13, 0.0, 0.0, 0.0)) == []
-    strict = Satake2009Tracker(cfg.model_copy(update={"coast_min_hits": 4}), DetectionContract())
+    strict = Satake2009Tracker(cfg.model_copy(update={"coast_min_hits": 4}), CONTRACT)
     for k in range(3):
         strict.update(k * 50_000_000, det, _frame(k, 0.0, 0.0, 0.0))
     assert strict.update(3 * 50_000_000, [], _frame(3, 0.0, 0.0, 0.0)) == []
@@ -80,7 +87,7 @@ def test_a_second_match_on_the_same_body_starts_no_track() -> None:
     # second, unmatched, is within 0.5 m of it and starts nothing. At 0.8 m it would.
     box = Box2D(0, 0, 1, 1)
     for gap, n_tracks in ((0.3, 1), (0.8, 2)):
-        trk = Satake2009Tracker(Satake2009TrackerConfig(), DetectionContract())
+        trk = Satake2009Tracker(Satake2009TrackerConfig(**NO_SEARCH), CONTRACT)
         trk.update(0, [Detection((3.0, 0.0, 1.7), 1.7, 1.0, box)], _frame(0, 0.0, 0.0, 0.0))
         dets = [
             Detection((3.0, 0.0, 1.7), 1.7, 1.0, box),
@@ -94,3 +101,9 @@ def test_distance_grid() -> None:
     # 1.0 * 1.5^k up to 3.5: 1.0, 1.5, 2.25, 3.375
     cfg = Satake2009DetectorConfig(min_distance_m=1.0, max_distance_m=3.5, distance_ratio=1.5)
     assert distance_grid(cfg) == pytest.approx([1.0, 1.5, 2.25, 3.375])
+
+
+def test_the_tracker_needs_the_satake2009_detectors_contract() -> None:
+    # It searches templates in the detector's depth with the detector's settings.
+    with pytest.raises(ValueError, match="pair it with detector satake2009"):
+        Satake2009Tracker(Satake2009TrackerConfig(), DetectionContract())

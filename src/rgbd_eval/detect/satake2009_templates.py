@@ -145,25 +145,60 @@ class Match:
     box: tuple[int, int, int, int]  # left, top, width, height of the template
 
 
+def agreement_u8(
+    depth: NDArray[np.float32], distance: float, band_m: float, gap_m: float
+) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
+    """Per pixel (255 yes, 0 no): within ``band_m`` of ``distance`` (body); free behind it.
+
+    Free is farther than ``distance + gap_m`` or without depth (NaN).
+    """
+    near: NDArray[np.uint8] = cv2.inRange(depth, distance - band_m, distance + band_m)
+    free: NDArray[np.uint8] = 255 - cv2.compare(depth, distance + gap_m, cv2.CMP_LE)
+    return near, free
+
+
 def agreement(
     depth: NDArray[np.float32], distance: float, band_m: float, gap_m: float
 ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """Per pixel: is it within ``band_m`` of ``distance`` (body), is it free behind (1/0)."""
-    with np.errstate(invalid="ignore"):
-        near = (np.abs(depth - distance) < band_m).astype(np.float32)
-        free = (~(depth <= distance + gap_m)).astype(np.float32)  # farther, or no depth
-    return near, free
+    """:func:`agreement_u8` as 1.0 / 0.0."""
+    near, free = agreement_u8(depth, distance, band_m, gap_m)
+    return near.astype(np.float32) / 255.0, free.astype(np.float32) / 255.0
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """What scoring a template at one distance needs: ``near - free`` and ``free``'s integral.
+
+    ``sum(near m) + sum(free (1 - m)) = sum((near - free) m) + sum(free)`` over a box
+    (``m`` the mask): one correlation per template and one integral image per distance.
+    """
+
+    diff: NDArray[np.float32]
+    free_integral: NDArray[np.float64]
+
+    @staticmethod
+    def of(near: NDArray[np.generic], free: NDArray[np.generic], unit: float = 1.0) -> Agreement:
+        """From maps in which ``unit`` means yes (1.0 for float maps, 255 for 8-bit ones)."""
+        diff = (near.astype(np.float32) - free.astype(np.float32)) * np.float32(1.0 / unit)
+        ii = cv2.integral(free, sdepth=cv2.CV_64F) * (1.0 / unit)
+        return Agreement(diff, ii)
+
+    def score(self, t: DistanceTemplate) -> NDArray[np.float32]:
+        """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
+        inner = t.mask.astype(np.float32)
+        h, w = inner.shape
+        a = cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR)
+        ii = self.free_integral
+        box = ii[h:, w:] - ii[:-h, w:] - ii[h:, :-w] + ii[:-h, :-w]
+        out: NDArray[np.float32] = ((a + box) / float(inner.size)).astype(np.float32)
+        return out
 
 
 def score_agreement(
     near: NDArray[np.float32], free: NDArray[np.float32], t: DistanceTemplate
 ) -> NDArray[np.float32]:
     """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
-    inner = t.mask.astype(np.float32)
-    a = cv2.matchTemplate(near, inner, cv2.TM_CCORR)
-    b = cv2.matchTemplate(free, 1.0 - inner, cv2.TM_CCORR)
-    out: NDArray[np.float32] = ((a + b) / float(inner.size)).astype(np.float32)
-    return out
+    return Agreement.of(near, free).score(t)
 
 
 def score_map(

@@ -1,0 +1,76 @@
+"""Colour rejection of satake2009's false detections (seed 002, 2.2; the test is ours).
+
+The seed rejects "objects with similar silhouette to person" (its Fig. 5) "using color and
+texture information" and gives no detail. Our test: a person's head (skin, hair) and
+torso (clothes) differ in colour, where a person-shaped object (mannequin, cabinet,
+pillar, coat stand with one coat, plant) is one material from top to bottom. Over the
+body pixels of a match (depth within ``band_m`` of its distance), the mean CIELAB
+chromaticity ``(a*, b*)`` of the head rows (top quarter of the head-to-hip box) and of
+the torso rows (its lower 55 %) must differ by at least ``min_chroma``. Lightness is
+left out: shading alone makes the top of a uniform object darker or lighter than its
+middle.
+
+Known failures, by construction: a person whose hair and top are the same colour, seen
+from behind, is rejected; an object with a differently coloured top (a coat stand with
+a hat) is kept. A grey (mono) image carries no chromaticity: the test then keeps all.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+from numpy.typing import NDArray
+
+from rgbd_eval.detect.satake2009_templates import Match
+
+#: Rows of the head-to-hip box: the head is its top quarter, the torso its lower 55 %.
+HEAD_ROWS = (0.0, 0.25)
+TORSO_ROWS = (0.45, 1.0)
+#: Fewest body pixels per region for a decision (fewer: the match is kept).
+MIN_PIXELS = 12
+
+
+def _region(
+    lab: NDArray[np.float32], body: NDArray[np.bool_], rows: tuple[float, float]
+) -> NDArray[np.float32] | None:
+    h = body.shape[0]
+    r0, r1 = round(rows[0] * h), max(round(rows[0] * h) + 1, round(rows[1] * h))
+    sel = body[r0:r1]
+    if int(sel.sum()) < MIN_PIXELS:
+        return None
+    out: NDArray[np.float32] = lab[r0:r1][sel].mean(axis=0)
+    return out
+
+
+def head_torso_chroma(
+    rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, band_m: float
+) -> float | None:
+    """Distance between head and torso mean ``(a*, b*)`` (None: too few body pixels, or grey).
+
+    ``rgb`` and ``depth`` are at the same (processed) size as the match.
+    """
+    if rgb.ndim != 3:
+        return None
+    H, W = depth.shape
+    top = max(0, round(m.v))
+    bottom = min(H, m.box[1] + m.box[3])
+    left, right = max(0, m.box[0]), min(W, m.box[0] + m.box[2])
+    if bottom - top < 4 or right - left < 2:
+        return None
+    d = depth[top:bottom, left:right]
+    with np.errstate(invalid="ignore"):
+        body = np.abs(d - m.distance) < band_m
+    patch = np.ascontiguousarray(rgb[top:bottom, left:right]).astype(np.float32) / 255.0
+    lab = cv2.cvtColor(patch, cv2.COLOR_RGB2Lab)
+    head, torso = _region(lab, body, HEAD_ROWS), _region(lab, body, TORSO_ROWS)
+    if head is None or torso is None:
+        return None
+    return float(np.hypot(head[1] - torso[1], head[2] - torso[2]))
+
+
+def passes(
+    rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, band_m: float, min_chroma: float
+) -> bool:
+    """Whether a match is kept: head and torso differ by ``min_chroma`` or cannot be told."""
+    c = head_torso_chroma(rgb, depth, m, band_m)
+    return c is None or c >= min_chroma
