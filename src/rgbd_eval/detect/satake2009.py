@@ -44,11 +44,11 @@ class Satake2009DetectorConfig(ComponentConfig):
     num_disparities: int = Field(32, ge=16, le=512, description="SGBM disparity range (px)")
     block_size: int = Field(5, ge=1, le=21, description="SGBM block size (odd)")
     template_rows: int = Field(
-        24, ge=8, le=512, description="search at the image step where a template is this tall"
+        16, ge=8, le=512, description="search at the image step where a template is this tall"
     )
     min_distance_m: float = Field(1.0, gt=0.2, description="nearest searched distance")
     max_distance_m: float = Field(6.0, gt=0.5, le=20.0, description="farthest searched distance")
-    distance_ratio: float = Field(1.15, gt=1.0, le=2.0, description="step of the distance grid")
+    distance_ratio: float = Field(1.2, gt=1.0, le=2.0, description="step of the distance grid")
     band_m: float = Field(0.3, gt=0.0, le=2.0, description="body pixels within D +- band")
     gap_m: float = Field(0.5, gt=0.0, le=5.0, description="surroundings beyond D + gap")
     min_score: float = Field(0.8, ge=0.0, le=1.0, description="least evaluation value kept")

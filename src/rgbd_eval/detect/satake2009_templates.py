@@ -167,30 +167,32 @@ def agreement(
 
 @dataclass(frozen=True)
 class Agreement:
-    """What scoring a template at one distance needs: ``near - free`` and ``free``'s integral.
+    """What scoring a template at one distance needs: the maps ``near - free`` and ``free``.
 
     ``sum(near m) + sum(free (1 - m)) = sum((near - free) m) + sum(free)`` over a box
-    (``m`` the mask): one correlation per template and one integral image per distance.
+    (``m`` the mask): one correlation and one box filter per template.
     """
 
     diff: NDArray[np.float32]
-    free_integral: NDArray[np.float64]
+    free: NDArray[np.float32]
 
     @staticmethod
     def of(near: NDArray[np.generic], free: NDArray[np.generic], unit: float = 1.0) -> Agreement:
         """From maps in which ``unit`` means yes (1.0 for float maps, 255 for 8-bit ones)."""
-        diff = (near.astype(np.float32) - free.astype(np.float32)) * np.float32(1.0 / unit)
-        ii = cv2.integral(free, sdepth=cv2.CV_64F) * (1.0 / unit)
-        return Agreement(diff, ii)
+        scale = np.float32(1.0 / unit)
+        f = free.astype(np.float32) * scale
+        return Agreement(near.astype(np.float32) * scale - f, f)
 
     def score(self, t: DistanceTemplate) -> NDArray[np.float32]:
         """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
         inner = t.mask.astype(np.float32)
         h, w = inner.shape
-        a = cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR)
-        ii = self.free_integral
-        box = ii[h:, w:] - ii[:-h, w:] - ii[h:, :-w] + ii[:-h, :-w]
-        out: NDArray[np.float32] = ((a + box) / float(inner.size)).astype(np.float32)
+        out: NDArray[np.float32] = cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR)
+        box = cv2.boxFilter(
+            self.free, -1, (w, h), anchor=(0, 0), normalize=False, borderType=cv2.BORDER_CONSTANT
+        )
+        out += box[: out.shape[0], : out.shape[1]]
+        out *= np.float32(1.0 / inner.size)
         return out
 
 
