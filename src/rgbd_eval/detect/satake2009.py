@@ -54,7 +54,7 @@ class Satake2009DetectorConfig(ComponentConfig):
     min_score: float = Field(0.8, ge=0.0, le=1.0, description="least evaluation value kept")
     nms_iou: float = Field(0.3, ge=0.0, le=1.0, description="overlap that suppresses a match")
     min_head_torso_chroma: float = Field(
-        0.0, ge=0.0, le=100.0, description="colour test: head vs torso (a*, b*) distance (0: off)"
+        6.0, ge=0.0, le=100.0, description="colour test: head vs torso (a*, b*) distance (0: off)"
     )
 
     @property
@@ -127,17 +127,16 @@ class Satake2009Detector:
         cam, depth = sd.camera, sd.depth
         matches = self.candidates(depth, cam.fx)
         t2 = time.perf_counter()
-        if matches and self.cfg.min_head_torso_chroma > 0:
-            rgb = stereo.resized(left.image, self.cfg.size)
-            matches = [
-                m
-                for m in matches
-                if colour.passes(rgb, depth, m, self.cfg.band_m, self.cfg.min_head_torso_chroma)
-            ]
+        c = self.cfg
+        rgb = stereo.resized(left.image, c.size) if matches and c.min_head_torso_chroma > 0 else None
         out: list[Detection] = []
         sx, sy = left.camera.width / cam.width, left.camera.height / cam.height
         for m in matches:
-            D = search.body_distance(depth, m, self.cfg.band_m)
+            D = search.body_distance(depth, m, c.band_m)
+            if rgb is not None and not colour.passes(
+                rgb, depth, m, D, c.band_m, c.min_head_torso_chroma
+            ):
+                continue
             head = head_point(cam.fx, cam.fy, cam.cx, cam.cy, m, D)[None, :]
             wx, wy, wz = (float(v) for v in left.pose.transform_points(head)[0])
             x, y, w, h = m.box

@@ -3,16 +3,19 @@
 The seed rejects "objects with similar silhouette to person" (its Fig. 5) "using color and
 texture information" and gives no detail. Our test: a person's head (skin, hair) and
 torso (clothes) differ in colour, where a person-shaped object (mannequin, cabinet,
-pillar, coat stand with one coat, plant) is one material from top to bottom. Over the
-body pixels of a match (depth within ``band_m`` of its distance), the mean CIELAB
-chromaticity ``(a*, b*)`` of the head rows (top quarter of the head-to-hip box) and of
-the torso rows (its lower 55 %) must differ by at least ``min_chroma``. Lightness is
+pillar, coat stand with one coat, plant) is one material from top to bottom, or has no
+head where the template has one. Over the body pixels of a match (depth within
+``band_m`` of its distance), the head rows (top quarter of the head-to-hip box) and the
+torso rows (its lower 55 %) must each hold :data:`MIN_PIXELS` body pixels, and their mean
+CIELAB chromaticities ``(a*, b*)`` must differ by at least ``min_chroma``. Lightness is
 left out: shading alone makes the top of a uniform object darker or lighter than its
 middle.
 
 Known failures, by construction: a person whose hair and top are the same colour, seen
 from behind, is rejected; an object with a differently coloured top (a coat stand with
 a hat) is kept. A grey (mono) image carries no chromaticity: the test then keeps all.
+The stereo texture of the synthetic world is on every surface, so texture tells nothing
+there: this test uses colour only.
 """
 
 from __future__ import annotations
@@ -26,7 +29,7 @@ from rgbd_eval.detect.satake2009_templates import Match
 #: Rows of the head-to-hip box: the head is its top quarter, the torso its lower 55 %.
 HEAD_ROWS = (0.0, 0.25)
 TORSO_ROWS = (0.45, 1.0)
-#: Fewest body pixels per region for a decision (fewer: the match is kept).
+#: Fewest body pixels per region (fewer in the head rows: no head, not a person).
 MIN_PIXELS = 12
 
 
@@ -43,14 +46,14 @@ def _region(
 
 
 def head_torso_chroma(
-    rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, band_m: float
+    rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, distance: float, band_m: float
 ) -> float | None:
-    """Distance between head and torso mean ``(a*, b*)`` (None: too few body pixels, or grey).
+    """Distance between head and torso mean ``(a*, b*)`` of a colour image.
 
-    ``rgb`` and ``depth`` are at the same (processed) size as the match.
+    None when a region holds fewer than :data:`MIN_PIXELS` body pixels: no head where the
+    template has one. ``rgb`` and ``depth`` are at the same (processed) size as the match;
+    body pixels are those within ``band_m`` of ``distance`` (the match's refined distance).
     """
-    if rgb.ndim != 3:
-        return None
     H, W = depth.shape
     top = max(0, round(m.v))
     bottom = min(H, m.box[1] + m.box[3])
@@ -59,7 +62,7 @@ def head_torso_chroma(
         return None
     d = depth[top:bottom, left:right]
     with np.errstate(invalid="ignore"):
-        body = np.abs(d - m.distance) < band_m
+        body = np.abs(d - distance) < band_m
     patch = np.ascontiguousarray(rgb[top:bottom, left:right]).astype(np.float32) / 255.0
     lab = cv2.cvtColor(patch, cv2.COLOR_RGB2Lab)
     head, torso = _region(lab, body, HEAD_ROWS), _region(lab, body, TORSO_ROWS)
@@ -69,8 +72,15 @@ def head_torso_chroma(
 
 
 def passes(
-    rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, band_m: float, min_chroma: float
+    rgb: NDArray[np.uint8],
+    depth: NDArray[np.float32],
+    m: Match,
+    distance: float,
+    band_m: float,
+    min_chroma: float,
 ) -> bool:
-    """Whether a match is kept: head and torso differ by ``min_chroma`` or cannot be told."""
-    c = head_torso_chroma(rgb, depth, m, band_m)
-    return c is None or c >= min_chroma
+    """Whether a match is kept: a head and a torso that differ by ``min_chroma`` (grey: kept)."""
+    if rgb.ndim != 3:
+        return True
+    c = head_torso_chroma(rgb, depth, m, distance, band_m)
+    return c is not None and c >= min_chroma
