@@ -96,7 +96,9 @@ class Satake2009Contract(DetectionContract):
     detector: Satake2009DetectorConfig | None = None
 
 
-def head_point(cam_fx: float, cam_fy: float, cx: float, cy: float, m: st.Match, D: float) -> np.ndarray:
+def head_point(
+    cam_fx: float, cam_fy: float, cx: float, cy: float, m: st.Match, D: float
+) -> np.ndarray:
     """Eq. (1) inverted: the head top ``(x, y)`` at distance ``Z_c = D`` in camera coordinates."""
     return np.array([(m.u - cx) * D / cam_fx, (m.v - cy) * D / cam_fy, D])
 
@@ -128,7 +130,9 @@ class Satake2009Detector:
         matches = self.candidates(depth, cam.fx)
         t2 = time.perf_counter()
         c = self.cfg
-        rgb = stereo.resized(left.image, c.size) if matches and c.min_head_torso_chroma > 0 else None
+        rgb = (
+            stereo.resized(left.image, c.size) if matches and c.min_head_torso_chroma > 0 else None
+        )
         out: list[Detection] = []
         sx, sy = left.camera.width / cam.width, left.camera.height / cam.height
         for m in matches:

@@ -64,7 +64,7 @@ def head_torso_chroma(
     with np.errstate(invalid="ignore"):
         body = np.abs(d - distance) < band_m
     patch = np.ascontiguousarray(rgb[top:bottom, left:right]).astype(np.float32) / 255.0
-    lab = cv2.cvtColor(patch, cv2.COLOR_RGB2Lab)
+    lab = np.asarray(cv2.cvtColor(patch, cv2.COLOR_RGB2Lab), np.float32)
     head, torso = _region(lab, body, HEAD_ROWS), _region(lab, body, TORSO_ROWS)
     if head is None or torso is None:
         return None

@@ -57,12 +57,7 @@ def frame_depth(
     left, right = frame.stream("left"), frame.stream("right")
     key = (size, params)
     memo: tuple[Any, ...] | None = getattr(_LOCAL, "memo", None)
-    if (
-        memo is not None
-        and memo[0] == key
-        and memo[1]() is left.image
-        and memo[2]() is right.image
-    ):
+    if memo is not None and memo[0] == key and memo[1]() is left.image and memo[2]() is right.image:
         cached: stereo.StereoDepth = memo[3]
         return cached
     sd = stereo.stereo_depth(
@@ -74,7 +69,7 @@ def frame_depth(
 
 
 def _tallest(templates: list[st.DistanceTemplate]) -> int:
-    return max(t.mask.shape[0] for t in templates)
+    return max(int(t.mask.shape[0]) for t in templates)
 
 
 def level(templates: list[st.DistanceTemplate], distance: float, fx: float, rows: int) -> int:
@@ -84,18 +79,21 @@ def level(templates: list[st.DistanceTemplate], distance: float, fx: float, rows
     ~10x more).
     """
     tall = _tallest(templates) * (fx / st.F_REF) * (st.D_REF / distance)
-    return max(1, round(tall / rows))
+    return max(1, round(float(tall) / rows))
 
 
-def _reduced(depth: NDArray[np.float32], distance: float, n: int, params: MatchParams) -> st.Agreement:
+def _reduced(
+    depth: NDArray[np.float32], distance: float, n: int, params: MatchParams
+) -> st.Agreement:
     """The agreement maps at ``distance``, averaged over ``n x n`` cells (a partial last cell dropped)."""
     near, free = st.agreement_u8(depth, distance, params.band_m, params.gap_m)
     if n > 1:
         h, w = near.shape
         size = (w // n, h // n)
         if size[0] and size[1]:
-            near = cv2.resize(near[: size[1] * n, : size[0] * n], size, interpolation=cv2.INTER_AREA)
-            free = cv2.resize(free[: size[1] * n, : size[0] * n], size, interpolation=cv2.INTER_AREA)
+            cells = (slice(0, size[1] * n), slice(0, size[0] * n))
+            near = np.asarray(cv2.resize(near[cells], size, interpolation=cv2.INTER_AREA), np.uint8)
+            free = np.asarray(cv2.resize(free[cells], size, interpolation=cv2.INTER_AREA), np.uint8)
         else:
             near, free = near[:0, :0], free[:0, :0]
     return st.Agreement.of(near, free, 255.0)
@@ -189,7 +187,9 @@ def search_around(
         # full-resolution window covering every template whose anchor is within the radius
         left = max(0, math.floor(u0 - radius_px - max(t.anchor[0] for t in scaled) / k))
         top = max(0, math.floor(v0 - radius_px - max(t.anchor[1] for t in scaled) / k))
-        right = min(W, math.ceil(u0 + radius_px + max(t.mask.shape[1] - t.anchor[0] for t in scaled) / k))
+        right = min(
+            W, math.ceil(u0 + radius_px + max(t.mask.shape[1] - t.anchor[0] for t in scaled) / k)
+        )
         bottom = min(H, math.ceil(v0 + radius_px + max(t.mask.shape[0] - t.anchor[1] for t in scaled) / k))  # fmt: skip
         if right - left < 2 or bottom - top < 2:
             continue

@@ -152,9 +152,9 @@ def agreement_u8(
 
     Free is farther than ``distance + gap_m`` or without depth (NaN).
     """
-    near: NDArray[np.uint8] = cv2.inRange(depth, distance - band_m, distance + band_m)
-    free: NDArray[np.uint8] = 255 - cv2.compare(depth, distance + gap_m, cv2.CMP_LE)
-    return near, free
+    near = np.asarray(cv2.inRange(depth, distance - band_m, distance + band_m), np.uint8)
+    behind = np.asarray(cv2.inRange(depth, -np.inf, distance + gap_m), np.uint8)  # NaN: 0
+    return near, 255 - behind
 
 
 def agreement(
@@ -187,7 +187,7 @@ class Agreement:
         """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
         inner = t.mask.astype(np.float32)
         h, w = inner.shape
-        out: NDArray[np.float32] = cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR)
+        out = np.asarray(cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR), np.float32)
         box = cv2.boxFilter(
             self.free, -1, (w, h), anchor=(0, 0), normalize=False, borderType=cv2.BORDER_CONSTANT
         )

@@ -88,8 +88,7 @@ def resized(image: NDArray[np.generic], size: tuple[int, int]) -> NDArray[np.uin
         raise ValueError(f"stereo images must be 8-bit, got {img.dtype}")
     if (img.shape[1], img.shape[0]) == size:
         return img
-    out: NDArray[np.uint8] = cv2.resize(img, size, interpolation=cv2.INTER_AREA)
-    return out
+    return np.asarray(cv2.resize(img, size, interpolation=cv2.INTER_AREA), np.uint8)
 
 
 def _grey(image: NDArray[np.generic], size: tuple[int, int]) -> NDArray[np.uint8]:
