@@ -39,7 +39,7 @@ from rgbd_eval.errors import (
     TransformError,
 )
 from rgbd_eval.files import check_input
-from rgbd_eval.io import groundtruth, images, validate
+from rgbd_eval.io import groundtruth, images, validate, wheels
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -87,6 +87,8 @@ class SelectedTopics:
     odometry: str | None
     tf: tuple[str, ...]
     ground_truth: str | None
+    #: JointState of the wheels, integrated into odometry (``io.wheels``).
+    joint_states: str | None = None
 
     @property
     def rgb(self) -> str | None:
@@ -550,14 +552,23 @@ def open_recording(
                 if info_topic is not None:
                     info_topics[role] = info_topic
             odoms = [c.topic for c in conns if c.msgtype == ODOMETRY_TYPE]
+            joints = [c.topic for c in conns if c.msgtype == wheels.JOINT_STATE_TYPE]
+            joint_topic = None
+            if io.wheels is not None:  # wheel speeds replace nav_msgs/Odometry
+                joint_topic = _choose(
+                    path, "joint_states", "JointState", io.topic("joint_states"), joints, True
+                )
+                odoms = []
             odom_topic = _choose(path, "odometry", "odometry", io.topic("odometry"), odoms, False)
             tf_topics = tuple(c.topic for c in conns if c.msgtype == TF_TYPE)
             gts = [c.topic for c in conns if c.msgtype == GT_ARRAY_TYPE]
             gt_topic = _choose(
                 path, "ground_truth", "ground-truth", io.topic("ground_truth"), gts, False
             )
-            selected = SelectedTopics(chosen, info_topics, odom_topic, tf_topics, gt_topic)
-            index = _index_pass(path, src, selected)
+            selected = SelectedTopics(
+                chosen, info_topics, odom_topic, tf_topics, gt_topic, joint_topic
+            )
+            index = _index_pass(path, src, selected, io)
     except READ_ERRORS as err:
         raise InputError(path, f"cannot read recording: {err}") from err
 
@@ -729,11 +740,12 @@ def _rate(stamps: list[int] | None) -> float | None:
     return (len(stamps) - 1) / span if span > 0 else None
 
 
-def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
+def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfig) -> _Index:
     index = _Index()
     images_ = set(sel.streams.values())
     infos = set(sel.infos.values())
-    small = {t for t in (sel.odometry, sel.ground_truth) if t} | infos
+    small = {t for t in (sel.odometry, sel.ground_truth, sel.joint_states) if t} | infos
+    odometer = wheels.WheelOdometry(0.5 * io.wheels.separation_m) if io.wheels is not None else None
     small.update(sel.tf)
     wanted = small | images_
     for topic, log_ns, raw in src.messages(wanted):
@@ -759,6 +771,15 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
                 False,
                 topic,
             )
+        elif topic == sel.joint_states and odometer is not None and io.wheels is not None:
+            w = io.wheels
+            try:
+                v_L, v_R = wheels.wheel_speeds(msg, w.left_joint, w.right_joint, w.radius_m)
+                pose = odometer.add(_stamp_of(msg), v_L, v_R).pose()
+            except ValueError as err:
+                raise DecodeError(path, str(err), topic) from err
+            index.odom_frames = (w.odom_frame, w.base_frame)
+            _add_tf(path, index.tf, w.odom_frame, w.base_frame, _stamp_of(msg), pose, False, topic)
         elif msgtype == TF_TYPE:
             static = topic.endswith("tf_static")
             for t in msg.transforms:
