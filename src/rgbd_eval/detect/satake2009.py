@@ -31,7 +31,7 @@ from rgbd_eval.detect import satake2009_colour as colour
 from rgbd_eval.detect import satake2009_search as search
 from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
-from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
+from rgbd_eval.plugins import DetectionContract, DetectorSpec, register_detector
 from rgbd_eval.types import Box2D, Detection, Frame
 
 
@@ -159,7 +159,7 @@ register_detector(
         "satake2009",
         Satake2009DetectorConfig,
         Satake2009Detector,
-        streams=(StreamSpec("left"), StreamSpec("right")),
+        streams=search.STREAMS,
         contract=lambda c: Satake2009Contract(detector=c),
         stages=("stereo", "templates", "colour"),
         summary="SGBM stereo depth, upper-body distance templates (3 orientations)",

@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
+from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.types import Frame
 
 
@@ -50,10 +51,34 @@ def _matcher(params: stereo.SgbmParams) -> cv2.StereoSGBM:
     return matchers[params]
 
 
+#: The streams satake2009 reads: the left image, and the right one or a DisparityImage.
+STREAMS = (
+    StreamSpec("left"),
+    StreamSpec("right", required=False),
+    StreamSpec("disparity", required=False),
+)
+
+
 def frame_depth(
     frame: Frame, size: tuple[int, int], params: stereo.SgbmParams
 ) -> stereo.StereoDepth:
-    """SGBM depth of the frame's ``left``/``right`` pair at ``size``, computed once per frame."""
+    """Depth of the left view at ``size``, computed once per frame.
+
+    From a ``stereo_msgs/DisparityImage`` (``disparity`` stream, already depth) when the
+    recording has one, else SGBM on the ``left``/``right`` pair. InputError-free: a frame
+    with neither is a ValueError naming what is missing.
+    """
+    if "disparity" in frame.streams:
+        given = frame.stream("disparity")
+        if (given.camera.width, given.camera.height) == size:
+            return stereo.StereoDepth(given.image, given.camera)
+        depth = cv2.resize(given.image, size, interpolation=cv2.INTER_NEAREST)
+        return stereo.StereoDepth(np.asarray(depth, np.float32), given.camera.scaled(*size))
+    if "right" not in frame.streams:
+        raise ValueError(
+            f"frame {frame.index} has no right image and no DisparityImage: satake2009 needs "
+            "a stereo pair (--topic right=/name) or a disparity (--topic disparity=/name)"
+        )
     left, right = frame.stream("left"), frame.stream("right")
     key = (size, params)
     memo: tuple[Any, ...] | None = getattr(_LOCAL, "memo", None)

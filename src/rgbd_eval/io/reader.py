@@ -43,6 +43,7 @@ from rgbd_eval.io import groundtruth, images, validate, wheels
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
+    DISPARITY_TYPE,
     GT_ARRAY_TYPE,
     IMAGE_TYPE,
     ODOMETRY_TYPE,
@@ -54,7 +55,7 @@ from rgbd_eval.io.tf import TfBuffer, TransformLookupError
 from rgbd_eval.plugins import StreamSpec, role_kind
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Frame, Pose, Stream
 
-_IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+_IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE, DISPARITY_TYPE)
 
 #: The streams read when a caller names none: colour and depth (the RGB-D methods).
 RGBD_STREAMS = (StreamSpec("colour"), StreamSpec("depth"))
@@ -65,6 +66,7 @@ ALL_STREAMS = (
     StreamSpec("thermal", required=False),
     StreamSpec("left", required=False),
     StreamSpec("right", required=False),
+    StreamSpec("disparity", required=False),
 )
 
 
@@ -331,8 +333,12 @@ class Recording:
     def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
         kind = role_kind(role)
         try:
-            if kind == "depth":
-                img: Any = images.decode_depth(msg)
+            img: Any
+            if kind == "disparity":
+                img = images.depth_from_disparity_message(msg)
+                encoding = "depth"
+            elif kind == "depth":
+                img = images.decode_depth(msg)
                 encoding = "depth"
             elif kind == "thermal":
                 img = images.decode_mono(msg)
@@ -400,6 +406,8 @@ def image_kinds(topic: str, msg: Any) -> tuple[str, ...]:
     pair; ``mono8`` is thermal on a thermal topic, else colour.
     """
     name = topic.lower()
+    if hasattr(msg, "image") and hasattr(msg, "f"):  # stereo_msgs/DisparityImage
+        return ("disparity",)
     if hasattr(msg, "format"):
         if "compressedDepth" in str(msg.format):
             return ("depth",)
@@ -428,6 +436,7 @@ _KIND_NAMES = {
     "thermal": "thermal image",
     "left": "left stereo image",
     "right": "right stereo image",
+    "disparity": "disparity image",
 }
 
 
@@ -839,6 +848,18 @@ def _cameras(
         if msg is None:
             colour = cameras.get("colour")
             img = first[topic]
+            left = cameras.get("left")
+            if role_kind(role) == "disparity" and left is not None:
+                inner = img.image
+                if (int(inner.width), int(inner.height)) != (left.width, left.height):
+                    raise TopicError(
+                        path,
+                        f"disparity image is {inner.width}x{inner.height} but the left camera "
+                        f"is {left.width}x{left.height} (give --topic disparity_info=/name)",
+                        topic,
+                    )
+                cameras[role] = left  # a DisparityImage is in the left camera's frame
+                continue
             frame_id = img.header.frame_id.lstrip("/")
             if (
                 role_kind(role) == "depth"
@@ -865,6 +886,7 @@ def _cameras(
 
 
 def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str) -> CameraModel:
+    first = first.image if hasattr(first, "f") else first  # a DisparityImage's image
     try:
         camera = camera_model_from_info(msg)
     except ValueError as err:

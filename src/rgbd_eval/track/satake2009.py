@@ -40,7 +40,7 @@ from rgbd_eval.config import ComponentConfig
 from rgbd_eval.detect import satake2009_search as search
 from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect.satake2009 import Satake2009Contract, Satake2009DetectorConfig, head_point
-from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
+from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import satake2009_ekf as ekf
 from rgbd_eval.track.association import chi_square_gate, gnn_assign
 from rgbd_eval.types import (
@@ -304,7 +304,7 @@ register_tracker(
         Satake2009TrackerConfig,
         Satake2009Tracker,
         needs_frame=True,
-        streams=(StreamSpec("left"), StreamSpec("right")),
+        streams=search.STREAMS,
         check=check_contract,
         stages=("stereo", "search", "ekf"),
         summary="EKF per person in the robot frame, robot motion from odometry (2.3)",
