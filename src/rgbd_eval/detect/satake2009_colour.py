@@ -6,8 +6,8 @@ torso (clothes) differ in colour, where a person-shaped object (mannequin, cabin
 pillar, coat stand with one coat, plant) is one material from top to bottom, or has no
 head where the template has one. Over the body pixels of a match (depth within
 ``band_m`` of its distance), the head rows (top quarter of the head-to-hip box) and the
-torso rows (its lower 55 %) must each hold :data:`MIN_PIXELS` body pixels, and their mean
-CIELAB chromaticities ``(a*, b*)`` must differ by at least ``min_chroma``. Lightness is
+torso rows (its lower 55 %) must each hold :data:`MIN_PIXELS` body pixels, and the CIELAB
+chromaticities ``(a*, b*)`` of their mean colours must differ by at least ``min_chroma``. Lightness is
 left out: shading alone makes the top of a uniform object darker or lighter than its
 middle.
 
@@ -34,21 +34,22 @@ MIN_PIXELS = 12
 
 
 def _region(
-    lab: NDArray[np.float32], body: NDArray[np.bool_], rows: tuple[float, float]
-) -> NDArray[np.float32] | None:
+    rgb: NDArray[np.uint8], body: NDArray[np.bool_], rows: tuple[float, float]
+) -> NDArray[np.float64] | None:
+    """Mean colour (0..1) of the body pixels in a band of rows (None: too few of them)."""
     h = body.shape[0]
     r0, r1 = round(rows[0] * h), max(round(rows[0] * h) + 1, round(rows[1] * h))
-    sel = body[r0:r1]
-    if int(sel.sum()) < MIN_PIXELS:
+    sel = np.ascontiguousarray(body[r0:r1]).view(np.uint8)
+    if cv2.countNonZero(sel) < MIN_PIXELS:
         return None
-    out: NDArray[np.float32] = lab[r0:r1][sel].mean(axis=0)
-    return out
+    mean = cv2.mean(np.ascontiguousarray(rgb[r0:r1]), mask=sel)
+    return np.array(mean[:3], np.float64) / 255.0
 
 
 def head_torso_chroma(
     rgb: NDArray[np.uint8], depth: NDArray[np.float32], m: Match, distance: float, band_m: float
 ) -> float | None:
-    """Distance between head and torso mean ``(a*, b*)`` of a colour image.
+    """Distance between the CIELAB ``(a*, b*)`` of the head's and the torso's mean colour.
 
     None when a region holds fewer than :data:`MIN_PIXELS` body pixels: no head where the
     template has one. ``rgb`` and ``depth`` are at the same (processed) size as the match;
@@ -63,12 +64,13 @@ def head_torso_chroma(
     d = depth[top:bottom, left:right]
     with np.errstate(invalid="ignore"):
         body = np.abs(d - distance) < band_m
-    patch = np.ascontiguousarray(rgb[top:bottom, left:right]).astype(np.float32) / 255.0
-    lab = np.asarray(cv2.cvtColor(patch, cv2.COLOR_RGB2Lab), np.float32)
-    head, torso = _region(lab, body, HEAD_ROWS), _region(lab, body, TORSO_ROWS)
+    patch = rgb[top:bottom, left:right]
+    head, torso = _region(patch, body, HEAD_ROWS), _region(patch, body, TORSO_ROWS)
     if head is None or torso is None:
         return None
-    return float(np.hypot(head[1] - torso[1], head[2] - torso[2]))
+    pair = np.array([[head, torso]], np.float32)
+    lab = np.asarray(cv2.cvtColor(pair, cv2.COLOR_RGB2Lab), np.float32)[0]
+    return float(np.hypot(lab[0, 1] - lab[1, 1], lab[0, 2] - lab[1, 2]))
 
 
 def passes(
