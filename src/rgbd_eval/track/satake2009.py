@@ -3,7 +3,10 @@
 The robot motion ``u`` reaches the filter through the frame's odometry: the planar pose
 of the left camera (its ground projection, heading along its optical axis) at two
 frames gives the arc the robot drove (:func:`~.satake2009_ekf.motion_from_poses`), the
-same motion wheel speeds would give. Without odometry the robot stands still.
+same motion wheel speeds would give. The odometry is ``nav_msgs/Odometry``, ``/tf``, or
+the wheels' ``sensor_msgs/JointState`` integrated by the reader (``io.wheels``, 2.3.1's
+arcs: between two frames the arc recovered from the poses is the wheels' own when their
+speeds hold). Without odometry the robot stands still.
 
 Per frame (2.4 step 2): each track is predicted (eq. 5), its head top projected into
 the left image with eq. (1), and the distance templates are searched around it
