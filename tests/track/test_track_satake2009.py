@@ -15,6 +15,8 @@ from rgbd_eval.detect.satake2009 import (
 from rgbd_eval.plugins import DetectionContract
 from rgbd_eval.track.satake2009 import Satake2009Tracker, Satake2009TrackerConfig, planar_pose
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, Detection, Frame, Pose, Stream
+from tests.detect.satake_scenes import CAM as SEARCH_CAM
+from tests.detect.satake_scenes import scene_depth
 
 CAM = CameraModel(64, 48, 40.0, 40.0, 31.5, 23.5)
 CONTRACT = Satake2009Contract(detector=Satake2009DetectorConfig())
@@ -107,3 +109,44 @@ def test_the_tracker_needs_the_satake2009_detectors_contract() -> None:
     # It searches templates in the detector's depth with the detector's settings.
     with pytest.raises(ValueError, match="pair it with detector satake2009"):
         Satake2009Tracker(Satake2009TrackerConfig(), DetectionContract())
+
+
+def _depth_frame(index: int, person_y: float) -> Frame:
+    """A level camera 1.2 m up at the origin, a 1.75 m figure 3 m ahead at ``person_y``.
+
+    Its depth comes as the ``disparity`` stream (as a DisparityImage would give it), so
+    the tracker's template search runs on exact depth, without SGBM.
+    """
+    T = np.eye(4)
+    T[2, 3] = 1.2
+    pose = Pose.from_matrix(T).compose(OPTICAL_TO_BODY)
+    stamp = index * 50_000_000
+    img = np.zeros((SEARCH_CAM.height, SEARCH_CAM.width, 3), np.uint8)
+    left = Stream(img, "rgb8", SEARCH_CAM, stamp, pose)
+    depth = Stream(scene_depth((3.0, person_y)), "depth", SEARCH_CAM, stamp, pose)
+    return Frame(index, stamp, {"left": left, "disparity": depth}, camera_pose=pose)
+
+
+@pytest.mark.parametrize("local_search", [True, False])
+def test_the_search_around_the_prediction_observes_without_detections(local_search: bool) -> None:
+    # A person walks left at 0.6 m/s (3 cm per 50 ms frame), 3 m ahead. Whole-image
+    # detections (head top, 1.75 m) start the track in frames 0-1; from frame 2 on there
+    # are none. Searching around its prediction the tracker still observes the person
+    # every frame (VISIBLE, following y); without the search the track only coasts.
+    cfg = Satake2009TrackerConfig(local_search=local_search, coast_min_hits=2)
+    trk = Satake2009Tracker(cfg, CONTRACT)
+    box = Box2D(0, 0, 1, 1)
+    for k in range(7):
+        y = 0.2 + 0.03 * k
+        dets = [Detection((3.0, y, 1.75), 1.75, 0.9, box)] if k < 2 else []
+        out = trk.update(k * 50_000_000, dets, _depth_frame(k, y))
+    assert [o.track_id for o in out] == [1]
+    if local_search:
+        assert out[0].visibility.name == "VISIBLE"
+        assert trk.tracks[0].hits == 7
+        # head-top observations: y within a few cm, the figure's head is at 3 m +- its depth
+        assert out[0].y == pytest.approx(0.2 + 0.03 * 6, abs=0.06)
+        assert out[0].x == pytest.approx(3.0, abs=0.2)
+    else:
+        assert out[0].visibility.name == "OCCLUDED"
+        assert trk.tracks[0].hits == 2
