@@ -9,10 +9,11 @@ arcs: between two frames the arc recovered from the poses is the wheels' own whe
 speeds hold). Without odometry the robot stands still.
 
 Per frame (2.4 step 2): each track is predicted (eq. 5), its head top projected into
-the left image with eq. (1), and the distance templates are searched around it
+the left image with eq. (1), and the distance templates, made for its predicted distance
+(2.4 step 2.2), are searched around it
 (:func:`rgbd_eval.detect.satake2009_search.search_around`: a window of
-``search_sigmas`` predicted standard deviations, three distances around the predicted
-one, best template wins); a match above the detector's ``min_score`` inside the
+``search_sigmas`` predicted standard deviations, best template wins; ``search_steps``
+adds distances around the predicted one); a match above the detector's ``min_score`` inside the
 chi-square gate is the track's observation ``y_t`` (eq. 4), nearest tracks first so that
 an occluder is claimed by its own track. Tracks the search misses are then associated
 with the detector's whole-image detections (world frame, moved into the robot frame)
@@ -81,7 +82,10 @@ class Satake2009TrackerConfig(ComponentConfig):
         24, ge=8, le=512, description="search where the tallest template is this tall"
     )
     search_distance_ratio: float = Field(
-        1.08, gt=1.0, le=1.5, description="distances D/r, D, D r around the predicted D"
+        1.08, gt=1.0, le=1.5, description="step r of the distances D r^k around the predicted D"
+    )
+    search_steps: int = Field(
+        0, ge=0, le=3, description="k = -steps..steps: distances searched around D (0: D only)"
     )
 
 
@@ -207,7 +211,8 @@ class Satake2009Tracker:
             max(cfg.min_search_radius_px, cam.fx * cfg.search_sigmas * sigma / D),
         )
         r = cfg.search_distance_ratio
-        distances = [search.quantised(d) for d in (D / r, D, D * r)]
+        k = cfg.search_steps
+        distances = [search.quantised(D * r**i) for i in range(-k, k + 1)]
         m = search.search_around(
             depth, cam.fx, self.templates, (u, v), distances, radius, cfg.search_rows,
             self.det.match, cache=self._scaled,
