@@ -127,21 +127,26 @@ def _depth_frame(index: int, person_y: float) -> Frame:
     return Frame(index, stamp, {"left": left, "disparity": depth}, camera_pose=pose)
 
 
-@pytest.mark.parametrize("local_search", [True, False])
-def test_the_search_around_the_prediction_observes_without_detections(local_search: bool) -> None:
+@pytest.mark.parametrize(("local_search", "chroma"), [(True, 0.0), (False, 0.0), (True, 6.0)])
+def test_the_search_around_the_prediction_observes_without_detections(
+    local_search: bool, chroma: float
+) -> None:
     # A person walks left at 0.6 m/s (3 cm per 50 ms frame), 3 m ahead. Whole-image
     # detections (head top, 1.75 m) start the track in frames 0-1; from frame 2 on there
     # are none. Searching around its prediction the tracker still observes the person
-    # every frame (VISIBLE, following y); without the search the track only coasts.
+    # every frame (VISIBLE, following y); without the search the track only coasts. The
+    # images are blank (one colour top to bottom): with the colour test on (min chroma 6)
+    # the search's observations are rejected as a mannequin's would be, and it coasts too.
     cfg = Satake2009TrackerConfig(local_search=local_search, coast_min_hits=2)
-    trk = Satake2009Tracker(cfg, CONTRACT)
+    contract = Satake2009Contract(detector=Satake2009DetectorConfig(min_head_torso_chroma=chroma))
+    trk = Satake2009Tracker(cfg, contract)
     box = Box2D(0, 0, 1, 1)
     for k in range(7):
         y = 0.2 + 0.03 * k
         dets = [Detection((3.0, y, 1.75), 1.75, 0.9, box)] if k < 2 else []
         out = trk.update(k * 50_000_000, dets, _depth_frame(k, y))
     assert [o.track_id for o in out] == [1]
-    if local_search:
+    if local_search and not chroma:
         assert out[0].visibility.name == "VISIBLE"
         assert trk.tracks[0].hits == 7
         # head-top observations: y within a few cm, the figure's head is at 3 m +- its depth

@@ -13,7 +13,8 @@ the left image with eq. (1), and the distance templates, made for its predicted 
 (2.4 step 2.2), are searched around it
 (:func:`rgbd_eval.detect.satake2009_search.search_around`: a window of
 ``search_sigmas`` predicted standard deviations, best template wins; ``search_steps``
-adds distances around the predicted one); a match above the detector's ``min_score`` inside the
+adds distances around the predicted one); a match above the detector's ``min_score``
+that passes its colour test (:mod:`rgbd_eval.detect.satake2009_colour`) inside the
 chi-square gate is the track's observation ``y_t`` (eq. 4), nearest tracks first so that
 an occluder is claimed by its own track. Tracks the search misses are then associated
 with the detector's whole-image detections (world frame, moved into the robot frame)
@@ -41,8 +42,10 @@ import numpy as np
 from pydantic import Field
 
 from rgbd_eval.config import ComponentConfig
+from rgbd_eval.detect import satake2009_colour as colour
 from rgbd_eval.detect import satake2009_search as search
 from rgbd_eval.detect import satake2009_templates as st
+from rgbd_eval.detect import stereo
 from rgbd_eval.detect.satake2009 import Satake2009Contract, Satake2009DetectorConfig, head_point
 from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import satake2009_ekf as ekf
@@ -174,6 +177,7 @@ class Satake2009Tracker:
             heads[i] = to_cam.transform_points(np.array([[wx, wy, float(t.x[2])]]))[0]
         found: dict[int, _Observation] = {}
         claimed: list[ekf.Array] = []
+        rgb: np.ndarray | None = None
         for i in sorted(pending, key=lambda i: float(heads[i][2])):  # nearest first
             t, p = self.tracks[i], heads[i]
             if not p[2] > self.det.min_distance_m * 0.5:
@@ -182,6 +186,13 @@ class Satake2009Tracker:
             if m is None:
                 continue
             D = search.body_distance(sd.depth, m, self.det.band_m)
+            if self.det.min_head_torso_chroma > 0:
+                if rgb is None:
+                    rgb = stereo.resized(left.image, self.det.size)
+                if not colour.passes(
+                    rgb, sd.depth, m, D, self.det.band_m, self.det.min_head_torso_chroma
+                ):
+                    continue
             head = head_point(cam.fx, cam.fy, cam.cx, cam.cy, m, D)[None, :]
             world = left.pose.transform_points(head)[0]
             y = to_robot(robot, (float(world[0]), float(world[1]), float(world[2])))
