@@ -167,9 +167,9 @@ def search_whole(
             if th > maps.diff.shape[0] or tw > maps.diff.shape[1] or th < 8:
                 continue
             scores = maps.score(t)
+            if cv2.minMaxLoc(scores)[1] < params.min_score:
+                continue  # nothing to collect (the common case: one C pass, no allocation)
             ys, xs = np.nonzero(scores >= params.min_score)
-            if not len(ys):
-                continue
             order = np.argsort(-scores[ys, xs], kind="stable")[:per_template]
             for y, x in zip(ys[order], xs[order], strict=True):
                 found.append(
