@@ -48,7 +48,7 @@ class ComponentConfig(_Model):
 
 
 #: Roles of non-image topics that ``io.topics`` may also name.
-_OTHER_ROLES = ("odometry", "ground_truth")
+_OTHER_ROLES = ("odometry", "ground_truth", "joint_states")
 
 
 def _check_role(role: str) -> None:
@@ -59,6 +59,17 @@ def _check_role(role: str) -> None:
         return
     known = ", ".join([*ROLES, *(f"{r}_info" for r in ROLES), *_OTHER_ROLES, "depth_2, ..."])
     raise ValueError(f"unknown topic role {role!r} (known: {known})")
+
+
+class WheelsConfig(_Model):
+    """Odometry from a ``sensor_msgs/JointState`` of a differential drive's wheels."""
+
+    left_joint: str = Field(description="name of the left wheel's joint")
+    right_joint: str = Field(description="name of the right wheel's joint")
+    radius_m: float = Field(gt=0.0, le=5.0, description="wheel radius (joint rad/s -> m/s)")
+    separation_m: float = Field(gt=0.0, le=10.0, description="distance 2d between the wheels")
+    base_frame: str = Field("base_link", description="the robot frame the wheels move")
+    odom_frame: str = Field("odom", description="the frame the robot starts at the origin of")
 
 
 class IoConfig(_Model):
@@ -78,6 +89,9 @@ class IoConfig(_Model):
     )
     max_pose_extrapolation_ms: float = Field(
         200.0, ge=0, description="how far a pose may be held beyond the first/last odometry stamp"
+    )
+    wheels: WheelsConfig | None = Field(
+        None, description="odometry from wheel speeds (JointState) instead of nav_msgs/Odometry"
     )
 
     @model_validator(mode="after")

@@ -47,7 +47,7 @@ _SCANNED_PACKAGES = ("rgbd_eval.detect", "rgbd_eval.track", "rgbd_eval.methods")
 
 #: The stream roles a recording can hold (``io.topics.<role>``, ``--topic ROLE=/name``).
 #: Extra depth cameras of a rig are ``depth_2``, ``depth_3``, ... (see :func:`role_kind`).
-ROLES = ("colour", "depth", "thermal", "left", "right")
+ROLES = ("colour", "depth", "thermal", "left", "right", "disparity")
 
 
 def role_kind(role: str) -> str:

@@ -145,25 +145,62 @@ class Match:
     box: tuple[int, int, int, int]  # left, top, width, height of the template
 
 
+def agreement_u8(
+    depth: NDArray[np.float32], distance: float, band_m: float, gap_m: float
+) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
+    """Per pixel (255 yes, 0 no): within ``band_m`` of ``distance`` (body); free behind it.
+
+    Free is farther than ``distance + gap_m`` or without depth (NaN).
+    """
+    near = np.asarray(cv2.inRange(depth, distance - band_m, distance + band_m), np.uint8)
+    behind = np.asarray(cv2.inRange(depth, -np.inf, distance + gap_m), np.uint8)  # NaN: 0
+    return near, 255 - behind
+
+
 def agreement(
     depth: NDArray[np.float32], distance: float, band_m: float, gap_m: float
 ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
-    """Per pixel: is it within ``band_m`` of ``distance`` (body), is it free behind (1/0)."""
-    with np.errstate(invalid="ignore"):
-        near = (np.abs(depth - distance) < band_m).astype(np.float32)
-        free = (~(depth <= distance + gap_m)).astype(np.float32)  # farther, or no depth
-    return near, free
+    """:func:`agreement_u8` as 1.0 / 0.0."""
+    near, free = agreement_u8(depth, distance, band_m, gap_m)
+    return near.astype(np.float32) / 255.0, free.astype(np.float32) / 255.0
+
+
+@dataclass(frozen=True)
+class Agreement:
+    """What scoring a template at one distance needs: the maps ``near - free`` and ``free``.
+
+    ``sum(near m) + sum(free (1 - m)) = sum((near - free) m) + sum(free)`` over a box
+    (``m`` the mask): one correlation and one box filter per template.
+    """
+
+    diff: NDArray[np.float32]
+    free: NDArray[np.float32]
+
+    @staticmethod
+    def of(near: NDArray[np.generic], free: NDArray[np.generic], unit: float = 1.0) -> Agreement:
+        """From maps in which ``unit`` means yes (1.0 for float maps, 255 for 8-bit ones)."""
+        scale = np.float32(1.0 / unit)
+        f = free.astype(np.float32) * scale
+        return Agreement(near.astype(np.float32) * scale - f, f)
+
+    def score(self, t: DistanceTemplate) -> NDArray[np.float32]:
+        """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
+        inner = t.mask.astype(np.float32)
+        h, w = inner.shape
+        out = np.asarray(cv2.matchTemplate(self.diff, inner, cv2.TM_CCORR), np.float32)
+        box = cv2.boxFilter(
+            self.free, -1, (w, h), anchor=(0, 0), normalize=False, borderType=cv2.BORDER_CONSTANT
+        )
+        out += box[: out.shape[0], : out.shape[1]]
+        out *= np.float32(1.0 / inner.size)
+        return out
 
 
 def score_agreement(
     near: NDArray[np.float32], free: NDArray[np.float32], t: DistanceTemplate
 ) -> NDArray[np.float32]:
     """Evaluation value of ``t`` with its top-left corner at every pixel (see the module)."""
-    inner = t.mask.astype(np.float32)
-    a = cv2.matchTemplate(near, inner, cv2.TM_CCORR)
-    b = cv2.matchTemplate(free, 1.0 - inner, cv2.TM_CCORR)
-    out: NDArray[np.float32] = ((a + b) / float(inner.size)).astype(np.float32)
-    return out
+    return Agreement.of(near, free).score(t)
 
 
 def score_map(

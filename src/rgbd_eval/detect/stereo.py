@@ -81,6 +81,16 @@ def make_matcher(params: SgbmParams) -> cv2.StereoSGBM:
     )
 
 
+def resized(image: NDArray[np.generic], size: tuple[int, int]) -> NDArray[np.uint8]:
+    """An 8-bit image at ``size = (width, height)`` (``INTER_AREA``; as is when it already fits)."""
+    img = np.asarray(image)
+    if img.dtype != np.uint8:
+        raise ValueError(f"stereo images must be 8-bit, got {img.dtype}")
+    if (img.shape[1], img.shape[0]) == size:
+        return img
+    return np.asarray(cv2.resize(img, size, interpolation=cv2.INTER_AREA), np.uint8)
+
+
 def _grey(image: NDArray[np.generic], size: tuple[int, int]) -> NDArray[np.uint8]:
     img = np.asarray(image)
     if img.ndim == 3:

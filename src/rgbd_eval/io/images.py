@@ -159,6 +159,25 @@ def decode_depth(msg: Any) -> NDArray[np.float32]:
     return _depth_from_array(image_array(msg))
 
 
+def depth_from_disparity_message(msg: Any) -> NDArray[np.float32]:
+    """Depth (m) of a ``stereo_msgs/DisparityImage``: ``Z = f T / d`` (NaN: no disparity).
+
+    ``d`` below the message's ``min_disparity`` (or not positive) has no depth. The
+    baseline field is ``T`` in ROS1 and ``t`` in ROS2.
+    """
+    img = msg.image
+    if img.encoding != "32FC1":
+        raise ImageFormatError(f"DisparityImage image must be 32FC1, got {img.encoding!r}")
+    f, baseline = float(msg.f), float(msg.T if hasattr(msg, "T") else msg.t)
+    if not (f > 0 and baseline > 0):
+        raise ImageFormatError(f"DisparityImage has f={f:g}, T={baseline:g}: both must be > 0")
+    d = np.asarray(image_array(img), dtype=np.float32)
+    valid = d > max(0.0, float(msg.min_disparity))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        depth = np.where(valid, np.float32(f * baseline) / d, np.float32(np.nan))
+    return depth.astype(np.float32)
+
+
 # ----------------------------------------------------------------------------- encoding
 
 

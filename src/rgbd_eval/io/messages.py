@@ -61,6 +61,8 @@ BOUNDING_BOXES_TYPE = "darknet_ros_msgs/msg/BoundingBoxes"
 
 IMAGE_TYPE = "sensor_msgs/msg/Image"
 COMPRESSED_IMAGE_TYPE = "sensor_msgs/msg/CompressedImage"
+#: A stereo matcher's output: a 32FC1 disparity image with the focal length and baseline.
+DISPARITY_TYPE = "stereo_msgs/msg/DisparityImage"
 CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
 ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
 TF_TYPE = "tf2_msgs/msg/TFMessage"

@@ -38,11 +38,12 @@ from rgbd_eval.errors import (
     TransformError,
 )
 from rgbd_eval.files import check_input
-from rgbd_eval.io import groundtruth, images, integrity, validate
+from rgbd_eval.io import groundtruth, images, integrity, validate, wheels
 from rgbd_eval.io.integrity import SkippedMessages
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
+    DISPARITY_TYPE,
     GT_ARRAY_TYPE,
     IMAGE_TYPE,
     ODOMETRY_TYPE,
@@ -54,7 +55,7 @@ from rgbd_eval.io.tf import TfBuffer, TransformLookupError
 from rgbd_eval.plugins import StreamSpec, role_kind
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Frame, Pose, Stream
 
-_IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE)
+_IMAGE_TYPES = (IMAGE_TYPE, COMPRESSED_IMAGE_TYPE, DISPARITY_TYPE)
 
 #: The streams read when a caller names none: colour and depth (the RGB-D methods).
 RGBD_STREAMS = (StreamSpec("colour"), StreamSpec("depth"))
@@ -65,6 +66,7 @@ ALL_STREAMS = (
     StreamSpec("thermal", required=False),
     StreamSpec("left", required=False),
     StreamSpec("right", required=False),
+    StreamSpec("disparity", required=False),
 )
 
 
@@ -87,6 +89,8 @@ class SelectedTopics:
     odometry: str | None
     tf: tuple[str, ...]
     ground_truth: str | None
+    #: JointState of the wheels, integrated into odometry (``io.wheels``).
+    joint_states: str | None = None
 
     @property
     def rgb(self) -> str | None:
@@ -327,8 +331,12 @@ class Recording:
     def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
         kind = role_kind(role)
         try:
-            if kind == "depth":
-                img: Any = images.decode_depth(msg)
+            img: Any
+            if kind == "disparity":
+                img = images.depth_from_disparity_message(msg)
+                encoding = "depth"
+            elif kind == "depth":
+                img = images.decode_depth(msg)
                 encoding = "depth"
             elif kind == "thermal":
                 img = images.decode_mono(msg)
@@ -396,6 +404,8 @@ def image_kinds(topic: str, msg: Any) -> tuple[str, ...]:
     pair; ``mono8`` is thermal on a thermal topic, else colour.
     """
     name = topic.lower()
+    if hasattr(msg, "image") and hasattr(msg, "f"):  # stereo_msgs/DisparityImage
+        return ("disparity",)
     if hasattr(msg, "format"):
         if "compressedDepth" in str(msg.format):
             return ("depth",)
@@ -424,6 +434,7 @@ _KIND_NAMES = {
     "thermal": "thermal image",
     "left": "left stereo image",
     "right": "right stereo image",
+    "disparity": "disparity image",
 }
 
 
@@ -571,14 +582,23 @@ def open_recording(
                 if info_topic is not None:
                     info_topics[role] = info_topic
             odoms = [c.topic for c in conns if c.msgtype == ODOMETRY_TYPE]
+            joints = [c.topic for c in conns if c.msgtype == wheels.JOINT_STATE_TYPE]
+            joint_topic = None
+            if io.wheels is not None:  # wheel speeds replace nav_msgs/Odometry
+                joint_topic = _choose(
+                    path, "joint_states", "JointState", io.topic("joint_states"), joints, True
+                )
+                odoms = []
             odom_topic = _choose(path, "odometry", "odometry", io.topic("odometry"), odoms, False)
             tf_topics = tuple(c.topic for c in conns if c.msgtype == TF_TYPE)
             gts = [c.topic for c in conns if c.msgtype == GT_ARRAY_TYPE]
             gt_topic = _choose(
                 path, "ground_truth", "ground-truth", io.topic("ground_truth"), gts, False
             )
-            selected = SelectedTopics(chosen, info_topics, odom_topic, tf_topics, gt_topic)
-            index = _index_pass(path, src, selected)
+            selected = SelectedTopics(
+                chosen, info_topics, odom_topic, tf_topics, gt_topic, joint_topic
+            )
+            index = _index_pass(path, src, selected, io)
     except READ_ERRORS as err:
         raise InputError(path, f"cannot read recording: {err}") from err
 
@@ -790,11 +810,12 @@ def _rate(stamps: list[int] | None) -> float | None:
     return (len(stamps) - 1) / span if span > 0 else None
 
 
-def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
+def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfig) -> _Index:
     index = _Index()
     images_ = set(sel.streams.values())
     infos = set(sel.infos.values())
-    small = {t for t in (sel.odometry, sel.ground_truth) if t} | infos
+    small = {t for t in (sel.odometry, sel.ground_truth, sel.joint_states) if t} | infos
+    odometer = wheels.WheelOdometry(0.5 * io.wheels.separation_m) if io.wheels is not None else None
     small.update(sel.tf)
     wanted = small | images_
     for topic, log_ns, raw in src.messages(wanted):
@@ -809,14 +830,15 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
             index.skips.add(topic, str(err))
             continue
         if topic in images_:
-            problem = integrity.image_problem(msg)
+            image = msg.image if hasattr(msg, "f") else msg  # a DisparityImage's image
+            problem = integrity.image_problem(image)
             if problem is not None:
                 index.skips.add(topic, problem)
                 continue
             index.stamps.setdefault(topic, []).append(_stamp_of(msg))
             index.ordinals.setdefault(topic, []).append(ordinal)
-            if not hasattr(msg, "format"):
-                index.sizes.setdefault(topic, []).append((int(msg.width), int(msg.height)))
+            if not hasattr(image, "format"):
+                index.sizes.setdefault(topic, []).append((int(image.width), int(image.height)))
             continue
         index.log_stamps.setdefault(topic, []).append(log_ns)
         if topic in infos:
@@ -839,6 +861,15 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
                 False,
                 topic,
             )
+        elif topic == sel.joint_states and odometer is not None and io.wheels is not None:
+            w = io.wheels
+            try:
+                v_L, v_R = wheels.wheel_speeds(msg, w.left_joint, w.right_joint, w.radius_m)
+                pose = odometer.add(_stamp_of(msg), v_L, v_R).pose()
+            except ValueError as err:
+                raise DecodeError(path, str(err), topic) from err
+            index.odom_frames = (w.odom_frame, w.base_frame)
+            _add_tf(path, index.tf, w.odom_frame, w.base_frame, _stamp_of(msg), pose, False, topic)
         elif msgtype == TF_TYPE:
             static = topic.endswith("tf_static")
             for t in msg.transforms:
@@ -905,6 +936,18 @@ def _cameras(
         if msg is None:
             colour = cameras.get("colour")
             img = first[topic]
+            left = cameras.get("left")
+            if role_kind(role) == "disparity" and left is not None:
+                inner = img.image
+                if (int(inner.width), int(inner.height)) != (left.width, left.height):
+                    raise TopicError(
+                        path,
+                        f"disparity image is {inner.width}x{inner.height} but the left camera "
+                        f"is {left.width}x{left.height} (give --topic disparity_info=/name)",
+                        topic,
+                    )
+                cameras[role] = left  # a DisparityImage is in the left camera's frame
+                continue
             frame_id = img.header.frame_id.lstrip("/")
             if (
                 role_kind(role) == "depth"
@@ -931,6 +974,7 @@ def _cameras(
 
 
 def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str) -> CameraModel:
+    first = first.image if hasattr(first, "f") else first  # a DisparityImage's image
     try:
         camera = camera_model_from_info(msg)
     except ValueError as err:
