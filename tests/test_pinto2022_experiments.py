@@ -36,6 +36,10 @@ def test_claims_are_checked_against_numbers() -> None:
     wide = {"200": _row(0.70, 0.2, 5, 2), "400": _row(0.81, 0.2, 3, 1)}
     assert not check_claims(wide, s_max, pairs, fps=40.0)[0].held  # 11 pp apart
     assert check_claims(wide, s_max, pairs, fps=40.0)[3].held
+    # the frame-rate claim is judged on CPU time; the wall-clock rate is only reported
+    timed = check_claims(recover, s_max, pairs, fps=40.0, wall_fps=12.5)[3]
+    assert timed.held and "40.0 frames/s from CPU time" in timed.evidence
+    assert "12.5 by the wall clock" in timed.evidence
     text = render({"II": {"still": recover["200"]}, "9": recover, "10": s_max}, claims, {})
     assert "| still | - / 80.00 |" in text and "[NOT held]" in text
 
