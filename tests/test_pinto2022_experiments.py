@@ -7,6 +7,9 @@ import pytest
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
 from rgbd_eval.methods.pinto2022_experiments import check_claims, render, trinet_to_units
+from rgbd_eval.plugins import ReproduceResult
+from rgbd_eval.report_html import reproduce_page
+from rgbd_eval.report_html.pages import paper_file
 from rgbd_eval.sim import load_scenario
 
 
@@ -60,3 +63,15 @@ def test_scenarios_follow_table_one() -> None:
         if name in durations:
             assert scenario.duration_s == durations[name]
             assert len(scenario.people) == (2 if name.startswith("changing") else 3)
+
+
+def test_reproduce_page_loads_the_paper_file() -> None:
+    # `reproduce pinto2022` writes reproduce.html through the shared paper loader, which
+    # refused configs/papers/pinto2022.yaml (exit 4) while its claims were a list.
+    paper = paper_file("pinto2022")
+    assert paper is not None
+    assert set(paper["claims"]) == {"barely_move", "errors_move", "chosen_pair", "frame_rate"}
+    data = {"tables": {"II": {"still": _row(0.8, 0.2, 1, 0)}}, "claims": []}
+    result = ReproduceResult(markdown="", data=data, claims=(("frame rate", True),))
+    html = reproduce_page(result, "pinto2022")
+    assert "still" in html and "seed 001, section V" in html
