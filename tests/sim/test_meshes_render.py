@@ -121,3 +121,27 @@ def test_person_sized_objects_are_person_sized() -> None:
     for kind in (ObstacleKind.COAT_STAND, ObstacleKind.PLANT, ObstacleKind.CABINET):
         # the detector keeps clusters 1.4 .. 2.3 m high (seed 000, Table 5.1)
         assert 1.4 <= DEFAULT_SIZES[kind][2] <= 2.3
+
+
+def test_static_cache_tells_cameras_with_one_frame_id_apart() -> None:
+    """Two cameras with the same frame id, one pose, but another size or focal length each
+    get their own static hits (the cache once keyed them by frame id alone)."""
+    from dataclasses import replace
+
+    from rgbd_eval.sim.simulate import Simulator
+
+    from .conftest import tiny_scenario
+
+    sim = Simulator(tiny_scenario(robot={}), 0)  # static robot: the cache is used
+    view = sim.scene_view(0, 0)
+    big = sim.rgb_camera  # 160x120
+    small = big.scaled(80, 60)  # same frame id, half the size
+    wide = replace(big, fx=big.fx / 2.0, fy=big.fy / 2.0)  # same size, twice the field of view
+    assert big.frame_id == small.frame_id == wide.frame_id
+    for camera in (big, small, wide, big, small):
+        got = view.render(camera, view.rgb_pose)
+        want = render_hits(sim._static_scene, camera, view.rgb_pose)  # static scene only
+        assert got.triangle.shape == (camera.height, camera.width)
+        static = got.triangle < sim.static.n_triangles  # people overlaid where they are nearer
+        assert np.array_equal(got.triangle[static], want.triangle[static])
+        assert static.mean() > 0.5

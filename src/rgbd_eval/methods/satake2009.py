@@ -2,7 +2,17 @@
 
 from __future__ import annotations
 
-from rgbd_eval.plugins import MethodSpec, register_method
+from collections.abc import Mapping
+from pathlib import Path
+
+from rgbd_eval.plugins import (
+    MethodSpec,
+    PaperSpec,
+    ReproduceOptions,
+    ReproduceResult,
+    register_method,
+    register_paper,
+)
 
 register_method(
     MethodSpec(
@@ -13,5 +23,21 @@ register_method(
         seed="002",
         gating="metric",
         config_file="methods/satake2009.yaml",
+    )
+)
+
+
+def _reproduce(_recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
+    from rgbd_eval.methods.satake2009_experiments import run
+
+    return run(options)
+
+
+register_paper(
+    PaperSpec(
+        method="satake2009",
+        title="seed 002 section 4: Fig. 8 as a closed loop (follow A while B and C cross), timing",
+        scenarios=(),  # the closed loop renders its own frames: its path depends on the tracker
+        run=_reproduce,
     )
 )

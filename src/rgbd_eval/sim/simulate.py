@@ -129,7 +129,9 @@ class Simulator:
         self.link_to_depth = rig.camera_link_to_depth(s)
         self.static = static_mesh(scenario.room, scenario.obstacles)
         self._static_scene = make_scene(self.static)
-        self._static_hits: dict[str, tuple[tuple[object, ...], Hits]] = {}
+        #: Static-scene hits per camera model (size, intrinsics and frame id): the pose they
+        #: were cast from, and the hits.
+        self._static_hits: dict[CameraModel, tuple[Pose, Hits]] = {}
         #: The people of the last rendered frame (index, mesh, scene), reused by scene_view.
         self._people: tuple[int, Mesh, o3d.t.geometry.RaycastingScene] | None = None
         self.light = light_direction(s.light_azimuth_deg, s.light_elevation_deg)
@@ -148,6 +150,20 @@ class Simulator:
         self._noise = noise_bank(shape, _NOISE_BANK, _rng(self.seed, _STREAM_RGB_BANK))
         self.odom_poses = integrate_odometry(
             true, scenario.odometry, _rng(self.seed, _STREAM_ODOMETRY)
+        )
+
+    def set_robot_pose(self, index: int, pose: tuple[float, float, float]) -> None:
+        """Closed loop: the robot's true ``(x, y, yaw)`` from frame ``index`` on.
+
+        The odometry is integrated again from the new true path, with the same noise
+        stream, so frames before ``index`` keep their poses and the result depends only
+        on the seed and the poses set.
+        """
+        if not 0 <= index < self.n_frames:
+            raise ValueError(f"index={index} must be in [0, {self.n_frames})")
+        self.true_poses[index:] = pose
+        self.odom_poses = integrate_odometry(
+            self.true_poses, self.scenario.odometry, _rng(self.seed, _STREAM_ODOMETRY)
         )
 
     @property
@@ -262,12 +278,15 @@ class Simulator:
         camera: CameraModel,
         pose: Pose,
     ) -> Hits:
-        """Hits of static scene + people: the static part is cached while the camera stands."""
-        key = (camera.frame_id, pose.translation, pose.rotation)
-        base = self._static_hits.get(camera.frame_id)
-        if base is None or base[0] != key:
-            base = (key, render_hits(self._static_scene, camera, pose))
-            self._static_hits[camera.frame_id] = base
+        """Hits of static scene + people: the static part is cached while the camera stands.
+
+        The cache is keyed by the whole camera model, so two cameras that share a frame id
+        but differ in size or intrinsics never get each other's hits.
+        """
+        base = self._static_hits.get(camera)
+        if base is None or base[0] != pose:
+            base = (pose, render_hits(self._static_scene, camera, pose))
+            self._static_hits[camera] = base
         window = people_window(people, camera, pose)
         return overlay_hits(base[1], people_scene, window, self.static.n_triangles)
 

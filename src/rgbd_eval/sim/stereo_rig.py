@@ -30,6 +30,7 @@ from rgbd_eval.sim.rig_sensors import (
     SceneView,
     register_rig_sensor,
 )
+from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose
 
 if TYPE_CHECKING:
@@ -136,21 +137,60 @@ class StereoPair:
         out: NDArray[np.uint8] = np.clip(img + 0.5, 0, 255).astype(np.uint8)
         return out
 
-    def write(self, writer: RecordingWriter, view: SceneView) -> None:
+    def render_pair(self, view: SceneView) -> tuple[NDArray[np.uint8], NDArray[np.uint8]]:
+        """The left and right images of one frame."""
+        return (
+            self.render(view, self.left, self.base_to_left),
+            self.render(view, self.right, self.base_to_right),
+        )
+
+    def write_pair(
+        self,
+        writer: RecordingWriter,
+        stamp_ns: int,
+        images: tuple[NDArray[np.uint8], NDArray[np.uint8]],
+    ) -> None:
+        """Write rendered left and right images with their CameraInfo."""
         ns = f"/{self.cfg.name}"
-        for side, cam, pose in (
-            ("left", self.left, self.base_to_left),
-            ("right", self.right, self.base_to_right),
-        ):
-            img = self.render(view, cam, pose)
+        for side, cam, img in (("left", self.left, images[0]), ("right", self.right, images[1])):
             writer.write_image(
-                f"{ns}/{side}/image_raw",
-                f"{ns}/{side}/camera_info",
-                view.stamp_ns,
-                img,
-                cam,
-                "rgb8",
+                f"{ns}/{side}/image_raw", f"{ns}/{side}/camera_info", stamp_ns, img, cam, "rgb8"
             )
+
+    def write(self, writer: RecordingWriter, view: SceneView) -> None:
+        self.write_pair(writer, view.stamp_ns, self.render_pair(view))
 
 
 register_rig_sensor(RigSensorSpec("stereo_pair", StereoPairConfig, StereoPair))
+
+
+#: The name of the pair :func:`with_stereo_rig` adds (topics ``/stereo/left/...``).
+STEREO_NAME = "stereo"
+
+
+def with_stereo_rig(scenario: Scenario, width: int = 512, height: int = 384) -> Scenario:
+    """``scenario`` seen through the Bumblebee2-like pair (``synth --rig stereo``).
+
+    The pair (:class:`StereoPairConfig` defaults, at ``width`` x ``height``: the seed's
+    processed 512x384, section 4) is added as ``stereo``, replacing any stereo pair, and the
+    frame rate becomes the camera's 20 fps (section 4). The Kinect, whose colour camera's
+    id buffer decides ground-truth visibility, takes the left camera's place, size and
+    field of view, so that the ground truth counts whom the pair can see. People, robot
+    path and room are unchanged; the name gains ``_stereo``.
+    """
+    pair = StereoPairConfig(name=STEREO_NAME, width=width, height=height)
+    half_h = math.atan(math.tan(math.radians(pair.hfov_deg) / 2.0) * height / width)
+    data = scenario.model_dump(mode="json")
+    data["name"] = f"{scenario.name}_stereo"
+    data["sensor"].update(
+        rate_hz=20.0,
+        width=width,
+        height=height,
+        hfov_deg=pair.hfov_deg,
+        vfov_deg=math.degrees(2.0 * half_h),
+        depth_decimation=4 if width % 4 == 0 and height % 4 == 0 else 1,
+    )
+    data["robot"].update(camera_x=pair.x, camera_height=pair.z, camera_tilt_deg=pair.tilt_deg)
+    rig = [r for r in data["rig"] if r["kind"] != "stereo_pair" and r["name"] != STEREO_NAME]
+    data["rig"] = [*rig, pair.model_dump(mode="json")]
+    return parse_scenario(data, f"{scenario.name} with the stereo rig")

@@ -10,7 +10,7 @@ same ground truth.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -19,7 +19,7 @@ from rgbd_eval.config import data_home
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
 from rgbd_eval.sim import rig
-from rgbd_eval.sim.rig_sensors import make_rig_sensor
+from rgbd_eval.sim.rig_sensors import RigSensor, make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
 from rgbd_eval.sim.simulate import SimFrame, Simulator
 from rgbd_eval.types import GroundTruthObject
@@ -71,7 +71,19 @@ def container_for(out_path: Path | str) -> SynthContainer:
     raise ValueError(f"out_path={str(out_path)!r} must end in .bag or .mcap")
 
 
-def _write_frame(w: RecordingWriter, sim: Simulator, f: SimFrame) -> None:
+def write_static(w: RecordingWriter, sim: Simulator, sensors: Sequence[RigSensor]) -> None:
+    """The static transforms of the robot's cameras and of the rig's sensors."""
+    first = sim.scenario.stamp_ns(0)
+    w.write_static_transform(first, rig.BASE_FRAME, rig.CAMERA_LINK, sim.base_to_link)
+    w.write_static_transform(first, rig.CAMERA_LINK, rig.RGB_FRAME, sim.link_to_rgb)
+    w.write_static_transform(first, rig.CAMERA_LINK, rig.DEPTH_FRAME, sim.link_to_depth)
+    for sensor in sensors:
+        for parent, child, pose in sensor.static_transforms():
+            w.write_static_transform(first, parent, child, pose)
+
+
+def write_frame(w: RecordingWriter, sim: Simulator, f: SimFrame) -> None:
+    """One frame's odometry, tf, Kinect images and ground truth (not the rig's sensors)."""
     stamp = f.stamp_ns
     w.write_odometry(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
     w.write_transform(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
@@ -106,19 +118,13 @@ def synthesize(
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     start = time.perf_counter()
     truth: list[GroundTruthObject] = []
-    first = scenario.stamp_ns(0)
     with RecordingWriter(
         out, container=kind, options=stream_options(scenario), overwrite=overwrite
     ) as w:
-        w.write_static_transform(first, rig.BASE_FRAME, rig.CAMERA_LINK, sim.base_to_link)
-        w.write_static_transform(first, rig.CAMERA_LINK, rig.RGB_FRAME, sim.link_to_rgb)
-        w.write_static_transform(first, rig.CAMERA_LINK, rig.DEPTH_FRAME, sim.link_to_depth)
         extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
-        for sensor in extra:
-            for parent, child, pose in sensor.static_transforms():
-                w.write_static_transform(first, parent, child, pose)
+        write_static(w, sim, extra)
         for f in sim.frames(list(range(total))):
-            _write_frame(w, sim, f)
+            write_frame(w, sim, f)
             for k, sensor in enumerate(extra):
                 sensor.write(w, sim.scene_view(f.index, k))
             truth.extend(f.ground_truth)
