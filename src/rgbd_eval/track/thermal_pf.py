@@ -5,17 +5,17 @@ image velocity (px/s) and its width factor ``a`` (a person is about 0.65 times a
 in profile as from the front: with a fixed width, walkers seen from the side were fitted
 25-40% too small). Prediction is constant velocity with Gaussian diffusion (position
 and velocity noise proportional to ``h``, so a near person moves more pixels), and a
-log-normal random walk of the size. The weight of a particle is
-``exp(score / score_scale)`` with ``score`` the silhouette's thermal-gradient score
-(:mod:`rgbd_eval.track.silhouette`) on the unthresholded image, times the interaction
-factor: several filters run side by side, and a particle overlapping another filter's
-estimate is penalised by ``exp(-rho * overlap / score_scale)`` (overlap: intersection over
+log-normal random walk of the size. The weight of a particle is ``exp(L)`` with ``L`` the
+log-likelihood the caller supplies (the thermal silhouette score over its scale, plus
+the colour and height terms of :mod:`rgbd_eval.track.cielniak2010`), times the
+interaction factor: several filters run side by side, and a particle overlapping another
+filter's estimate loses ``rho * overlap`` of log-likelihood (overlap: intersection over
 the smaller box, so that a small silhouette on a part of a tracked person, such as its
-legs, is penalised as fully as one on the whole person): ``rho`` (K/px) is the score a
-particle loses when it overlaps another estimate fully (seed 004, sections 3 and 6: the
-interaction factor rho prevents "target fetching", two filters converging on one person).
-The penalty is in the score's own units because the likelihood is sharp: a bounded
-factor such as ``1 - rho * IoU`` is outweighed by the likelihood of a hotter person.
+legs, is penalised as fully as one on the whole person; seed 004, sections 3 and 6: the
+interaction factor rho prevents "target fetching", two filters converging on one person,
+and section 6 changes it per pair when one person occludes the other). The penalty is in
+log-likelihood units because the likelihood is sharp: a bounded factor such as
+``1 - rho * IoU`` is outweighed by the likelihood of a hotter person.
 Resampling is systematic (Kitagawa 1996). All randomness comes from one
 :class:`numpy.random.Generator`: a run is bit-identical for a seed.
 """
@@ -23,15 +23,19 @@ Resampling is systematic (Kitagawa 1996). All randomness comes from one
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.track.silhouette import GradientImage, Silhouette, silhouette_scores, state_boxes
+from rgbd_eval.track.silhouette import Silhouette, state_boxes
 
 F64 = NDArray[np.float64]
+#: States (N, 6) -> log-likelihood (N,).
+LogLikelihood = Callable[[F64], F64]
+#: Another filter's box ``(u0, v0, u1, v1)`` and the interaction ``rho`` towards it.
+Neighbour = tuple[F64, float]
 #: (u, v, h, du, dv, a)
 STATE_SIZE = 6
 
@@ -44,8 +48,6 @@ class FilterParams:
     pos_noise: float = 0.1  # position diffusion, silhouette heights per sqrt(s)
     vel_noise: float = 0.5  # velocity random walk, heights/s per sqrt(s)
     size_noise: float = 0.1  # log-size random walk per sqrt(s)
-    score_scale: float = 0.2  # K/px: likelihood exp(score / score_scale)
-    rho: float = 2.0  # interaction: K/px of score lost at full overlap with another estimate
     min_height: float = 20.0  # px
     max_height: float = 1000.0  # px
     aspect_noise: float = 0.2  # log width-factor random walk per sqrt(s)
@@ -55,10 +57,6 @@ class FilterParams:
     def __post_init__(self) -> None:
         if self.n_particles < 2:
             raise ValueError(f"n_particles={self.n_particles} must be at least 2")
-        if self.score_scale <= 0.0:
-            raise ValueError(f"score_scale={self.score_scale} must be positive")
-        if self.rho < 0.0:
-            raise ValueError(f"rho={self.rho} must not be negative")
         if not 0.0 < self.min_height < self.max_height:
             raise ValueError(f"heights [{self.min_height}, {self.max_height}] must be increasing")
         if not 0.0 < self.min_aspect <= self.max_aspect:
@@ -107,8 +105,6 @@ class ThermalParticleFilter:
         self.particles = particles.astype(np.float64, copy=True)
         self.rng = rng
         self.estimate: F64 = self.particles.mean(axis=0)
-        #: Silhouette score (K/px) of the estimate after the last update.
-        self.score = 0.0
 
     @staticmethod
     def uniform(
@@ -168,27 +164,19 @@ class ThermalParticleFilter:
         a = p[:, 5] * np.exp(noise[:, 5] * q.aspect_noise * s)
         p[:, 5] = np.clip(a, q.min_aspect, q.max_aspect)
 
-    def update(self, grad: GradientImage, others: Sequence[F64] = ()) -> None:
-        """Weigh by the silhouette score and the interaction with ``others`` (their boxes), resample."""
-        q = self.params
-        scores = silhouette_scores(grad, self.silhouette, self.particles)
-        if others and q.rho > 0.0:
+    def update(self, loglik: LogLikelihood, others: Sequence[Neighbour] = ()) -> None:
+        """Weigh by ``loglik`` and the interaction with ``others``, estimate, resample."""
+        ll = np.asarray(loglik(self.particles), dtype=np.float64)
+        if others:
             boxes = state_boxes(self.particles, self.silhouette.width_ratio)
-            for other in others:
-                scores = scores - q.rho * box_iou(boxes, np.asarray(other), of_smaller=True)
-        w = np.exp((scores - scores.max()) / q.score_scale)
+            for box, rho in others:
+                if rho > 0.0:
+                    ll = ll - rho * box_iou(boxes, np.asarray(box), of_smaller=True)
+        w = np.exp(ll - ll.max())
         w /= w.sum()
         self.estimate = w @ self.particles
-        self.score = float(silhouette_scores(grad, self.silhouette, self.estimate[None, :])[0])
         self.particles = self.particles[systematic_resample(w, self.rng)]
 
-    def step(self, grad: GradientImage, dt: float, others: Sequence[F64] = ()) -> None:
+    def step(self, loglik: LogLikelihood, dt: float, others: Sequence[Neighbour] = ()) -> None:
         self.predict(dt)
-        self.update(grad, others)
-
-
-def step_filters(filters: Sequence[ThermalParticleFilter], grad: GradientImage, dt: float) -> None:
-    """Advance several filters one frame; each is penalised by the others' latest boxes."""
-    for i, f in enumerate(filters):
-        others = [g.box() for j, g in enumerate(filters) if j != i]
-        f.step(grad, dt, others)
+        self.update(loglik, others)
