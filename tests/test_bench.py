@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 import os
@@ -71,6 +72,21 @@ def test_fps_and_ratio_follow_from_the_totals(result: BenchResult) -> None:
     assert result.peak_rss_mib > 0.0
 
 
+def test_cpu_time_is_measured_per_repeat(result: BenchResult) -> None:
+    assert len(result.cpu_ms_repeats) == 2 and all(ms > 0.0 for ms in result.cpu_ms_repeats)
+    assert result.cpu_fps == pytest.approx(1e3 / result.cpu_ms)
+    assert result.to_json()["cpu_ms"] == pytest.approx(result.cpu_ms)
+
+
+def test_cpu_figures_are_the_median_repeat(result: BenchResult) -> None:
+    timed = dataclasses.replace(result, cpu_ms_repeats=(20.0, 30.0, 25.0))
+    # median of 20, 30, 25 ms is 25 ms -> 1000 / 25 = 40 fps
+    assert timed.cpu_ms == 25.0 and timed.cpu_fps == pytest.approx(40.0)
+    # not measured (a result built without it): 0 ms, and JSON says so with null
+    untimed = dataclasses.replace(result, cpu_ms_repeats=())
+    assert untimed.cpu_ms == 0.0 and untimed.to_json()["cpu_fps"] is None
+
+
 def test_one_repeat_stages_sum_to_the_wall_time(recording: Path) -> None:
     one = benchmark(recording, load_config(method="basso2012"), repeats=1)
     assert sum(one.stage_ms.values()) == pytest.approx(one.total_ms, rel=1e-9)
@@ -120,6 +136,8 @@ def test_cli_json_and_table(recording: Path) -> None:
         "decode alone",
         "pipeline/floor",
         "tracking alone",
+        "pipeline, CPU time",
+        "CPU time / wall time",
     ):
         assert label in table.output
 

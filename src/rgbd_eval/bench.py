@@ -82,6 +82,9 @@ class BenchResult:
     openblas_threads: str | None
     #: CPUs the process was allowed to run on (None: not known on this platform).
     cpus: tuple[int, ...] | None = None
+    #: CPU milliseconds per frame of the whole pipeline (this process, user + system), each
+    #: repeat. On a loaded machine the wall figures grow with the load; this does not.
+    cpu_ms_repeats: tuple[float, ...] = ()
 
     @property
     def total_ms(self) -> float:
@@ -112,6 +115,16 @@ class BenchResult:
     def track_alone_fps(self) -> float:
         """Frames per second of tracking alone, from cached detections."""
         return 1e3 / self.track_alone_ms if self.track_alone_ms > 0.0 else float("inf")
+
+    @property
+    def cpu_ms(self) -> float:
+        """Median CPU milliseconds per frame of the whole pipeline (0 when not measured)."""
+        return statistics.median(self.cpu_ms_repeats) if self.cpu_ms_repeats else 0.0
+
+    @property
+    def cpu_fps(self) -> float:
+        """Frames per second the pipeline would reach with its core to itself (CPU time)."""
+        return 1e3 / self.cpu_ms if self.cpu_ms > 0.0 else float("inf")
 
     def stage_fps(self, stage: str) -> float:
         """Frames per second of one stage alone (``inf`` when it took no time)."""
@@ -146,6 +159,9 @@ class BenchResult:
             "peak_rss_mib": self.peak_rss_mib,
             "openblas_threads": self.openblas_threads,
             "cpus": None if self.cpus is None else list(self.cpus),
+            "cpu_ms": self.cpu_ms,
+            "cpu_fps": self.cpu_fps if self.cpu_ms_repeats else None,
+            "cpu_ms_repeats": list(self.cpu_ms_repeats),
         }
 
 
@@ -154,6 +170,7 @@ class _Repeat:
     frames: int
     seconds: dict[str, float]
     wall_s: float
+    cpu_s: float
     detections: int
     tracks: int
     scored: bool
@@ -193,6 +210,7 @@ def _one_repeat(
 ) -> _Repeat:
     """Stream the recording once through detector, tracker and scorer (the loop of ``run``)."""
     wall = time.perf_counter()
+    cpu = time.process_time()
     recording = open_for(path, config)
     index_s = time.perf_counter() - wall
     start = time.perf_counter()
@@ -210,6 +228,7 @@ def _one_repeat(
         score_sequence(match_ground_truth(gt, detections.stamps_ns, config), tracks, config)
     score_s = gt_s + time.perf_counter() - start
     wall_s = time.perf_counter() - wall
+    cpu_s = time.process_time() - cpu
     seconds = {"index": index_s, "decode": detections.seconds["read"]}
     seconds.update(
         {
@@ -233,6 +252,7 @@ def _one_repeat(
         frames=len(detections.stamps_ns),
         seconds=seconds,
         wall_s=wall_s,
+        cpu_s=cpu_s,
         detections=sum(len(d) for d in detections.detections),
         tracks=sum(len(t) for t in tracks),
         scored=scored,
@@ -314,4 +334,5 @@ def benchmark(
         peak_rss_mib=peak_rss_mib(),
         openblas_threads=os.environ.get("OPENBLAS_NUM_THREADS"),
         cpus=allowed_cpus(),
+        cpu_ms_repeats=tuple(r.cpu_s * 1e3 / frames for r in runs),
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -73,6 +74,8 @@ def print_bench(result: BenchResult) -> None:
         style="bold",
         end_section=True,
     )
+    if result.cpu_ms_repeats:
+        table.add_row("pipeline, CPU time", f"{result.cpu_ms:.3f}", "", f"{result.cpu_fps:.1f}")
     table.add_row("decode alone (floor)", f"{result.floor_ms:.3f}", "", f"{result.floor_fps:.1f}")
     table.add_row(f"raw bytes ({result.raw_reader})", f"{result.raw_ms:.3f}", "", "")
     table.add_row(
@@ -91,6 +94,12 @@ def print_bench(result: BenchResult) -> None:
         f"{'scored' if result.scored else 'no ground truth, scoring not timed'}; "
         f"peak RSS {result.peak_rss_mib:.0f} MiB; OPENBLAS_NUM_THREADS={threads}; CPUs {cpus}"
     )
+    if result.cpu_ms_repeats:
+        console.print(
+            f"CPU time / wall time = {result.cpu_ms / result.total_ms:.2f} "
+            "(below 1: other processes shared the core; the CPU-time fps is what an idle core "
+            f"gives); load average {' '.join(f'{x:.2f}' for x in os.getloadavg())}"
+        )
 
 
 @handle_errors

@@ -78,6 +78,7 @@ def check_claims(
     s_max: Mapping[str, Mapping[str, Any]],
     pairs: Mapping[str, Mapping[str, Any]],
     fps: float,
+    wall_fps: float | None = None,
 ) -> list[Claim]:
     """The seed's claims (V-C2, V-F) against measured rows (summaries keyed by value)."""
     claims = []
@@ -116,7 +117,8 @@ def check_claims(
         Claim(
             f"the frame rate on one core beats the seed's {SEED_FPS:g} Hz with a GPU (V-C1)",
             fps > SEED_FPS,
-            f"{fps:.1f} frames/s (detection + tracking, one core)",
+            f"{fps:.1f} frames/s from CPU time (detection + tracking, one thread)"
+            + ("" if wall_fps is None else f"; {wall_fps:.1f} by the wall clock under this load"),
         )
     )
     return claims
@@ -142,21 +144,44 @@ def _sweep(
     return out
 
 
-def frame_rate(recording: Path, frames: int = 60) -> float:
-    """Frames per second of detection + tracking on ``frames`` frames, in this process."""
+@dataclass(frozen=True)
+class FrameRate:
+    """Detection + tracking speed on a few frames of one recording, in this process.
+
+    ``cpu_fps`` is from the CPU time of the thread that detects and tracks (OpenCV held to that
+    one thread meanwhile; onnxruntime runs there with one intra-op thread): what the pipeline
+    gives with a core to itself, whatever else loads the machine or runs in this process (a
+    Dask worker's threads); ``wall_fps`` falls with that load.
+    """
+
+    frames: int
+    cpu_fps: float
+    wall_fps: float
+
+
+def frame_rate(recording: Path, frames: int = 60) -> FrameRate:
+    """Frames per second of detection + tracking on ``frames`` frames, in this thread."""
+    import cv2
+
     config = load_config(method="pinto2022")
     detector = create_detector(config)
     tracker = create_tracker(config)
-    seconds = 0.0
+    cpu = wall = 0.0
     done = 0
-    for frame in open_for(recording, config).frames():
-        start = time.perf_counter()
-        tracker.update(frame.stamp_ns, detector.detect(frame))
-        seconds += time.perf_counter() - start
-        done += 1
-        if done == frames:
-            break
-    return done / seconds if seconds > 0 else 0.0
+    cv_threads = cv2.getNumThreads()
+    cv2.setNumThreads(1)
+    try:
+        for frame in open_for(recording, config).frames():
+            start, start_cpu = time.perf_counter(), time.thread_time()
+            tracker.update(frame.stamp_ns, detector.detect(frame))
+            wall += time.perf_counter() - start
+            cpu += time.thread_time() - start_cpu
+            done += 1
+            if done == frames:
+                break
+    finally:
+        cv2.setNumThreads(cv_threads)
+    return FrameRate(done, done / cpu if cpu > 0 else 0.0, done / wall if wall > 0 else 0.0)
 
 
 def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
@@ -212,11 +237,12 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
             "reid_dataset": tables["II"]["total"],
         }
     say("frame rate: detection + tracking on one process")
-    fps = frame_rate(recordings.get(TEST) or next(iter(dataset.values())))
-    claims = check_claims(tables["9"], tables["10"], tables["III"], fps)
+    rate = frame_rate(recordings.get(TEST) or next(iter(dataset.values())))
+    claims = check_claims(tables["9"], tables["10"], tables["III"], rate.cpu_fps, rate.wall_fps)
     data = {
         "tables": tables,
-        "frame_rate_hz": fps,
+        "frame_rate_hz": rate.cpu_fps,
+        "frame_rate_wall_hz": rate.wall_fps,
         "claims": [{"text": c.text, "held": c.held, "evidence": c.evidence} for c in claims],
         "seconds": time.perf_counter() - start,
     }
