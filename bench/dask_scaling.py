@@ -9,11 +9,11 @@ of every worker process, the load average before and after, and from the Dask ta
 stream each worker's busy seconds and the makespan; then the medians and ratios.
 
 The wall-clock ratio is what an idle machine shows. On a shared one it is noise,
-so the script also gives a load-independent estimate: ``CPU(local:1) /
-(CPU(local:2) / (2 x utilisation))``, the 1-worker CPU seconds over the CPU seconds
-the 2-worker run needed per worker slot, where utilisation is the workers' mean busy
-share of the makespan (task stream). It equals the wall-clock ratio when each worker
-has a core to itself.
+so the script also gives an estimate that the load does not move: the thread CPU
+seconds of every task (Dask's fine performance metrics, per task prefix) placed on
+the task graph ``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run
+and on two for ``local:2``'s: the makespans an idle machine would give, without
+transfer, scheduling or start-up costs.
 
     .venv/bin/python bench/dask_scaling.py               # moving_complex, 3 reps: ~2.5 min idle
     .venv/bin/python bench/dask_scaling.py --json runs/bench/dask_scaling.json
@@ -88,18 +88,96 @@ def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
+async def _heartbeat(dask_worker: Any) -> None:
+    """Send the worker's metrics to the scheduler now (they travel with heartbeats)."""
+    await dask_worker.heartbeat()
+
+
+def _execute_metrics(dask_scheduler: Any) -> dict[str, float]:
+    """Thread CPU seconds of the tasks run so far, per task prefix (Dask's fine metrics)."""
+    out: dict[str, float] = {}
+    for key, value in dask_scheduler.cumulative_worker_metrics.items():
+        if isinstance(key, tuple) and key[0] == "execute" and key[2:] == ("thread-cpu", "seconds"):
+            name = str(key[1]).lstrip("_")
+            out[name] = out.get(name, 0.0) + value
+    return out
+
+
+def _task_cpu(client: Any) -> dict[str, float]:
+    client.run(_heartbeat)
+    result: dict[str, float] = client.run_on_scheduler(_execute_metrics)
+    return result
+
+
+def _schedule(tasks: list[tuple[str, float, list[str]]], workers: int) -> float:
+    """Makespan of ``(name, seconds, dependencies)`` (in submission order, the scheduler's
+    priority) on ``workers`` slots by list scheduling: each free slot takes the first
+    ready task. No transfer or scheduling cost: the estimate of an idle machine."""
+    done: dict[str, float] = {}
+    free = [0.0] * workers
+    pending = list(tasks)
+    while pending:
+        slot = min(range(workers), key=lambda i: free[i])
+        ready = [t for t in pending if all(d in done for d in t[2])]
+        # The first task (submission order) whose inputs are ready soonest.
+        name, seconds, deps = min(ready, key=lambda t: max([done[d] for d in t[2]] + [0.0]))
+        start = max([free[slot], *(done[d] for d in deps)])
+        done[name] = free[slot] = start + seconds
+        pending.remove((name, seconds, deps))
+    return max(done.values())
+
+
+def _sweep_graph(
+    cpu: dict[str, float], counts: dict[str, int]
+) -> list[tuple[str, float, list[str]]]:
+    """The task graph ``run_sweep`` submits for one recording, each task taking its prefix's
+    measured thread CPU seconds divided evenly among the prefix's tasks."""
+
+    def each(prefix: str) -> float:
+        return cpu.get(prefix, 0.0) / max(1, counts.get(prefix, 1))
+
+    graph = [("prepare", each("prepare"), [])]
+    chunks = counts.get("detect_chunk", 0)
+    last = "prepare"
+    if chunks:
+        state = None
+        for k in range(chunks - 1):
+            graph.append(
+                (f"advance{k}", each("advance"), ["prepare"] + ([state] if state else []))
+            )
+            state = f"advance{k}"
+        for k in range(chunks):
+            deps = ["prepare"] + ([f"advance{k - 1}"] if k else [])
+            graph.append((f"chunk{k}", each("detect_chunk"), deps))
+        graph.append(("join", each("join"), ["prepare"] + [f"chunk{k}" for k in range(chunks)]))
+        last = "join"
+    graph.append(("brief", each("brief"), [last]))
+    graph += [(f"track{i}", each("track"), [last]) for i in range(counts.get("track", 0))]
+    return graph
+
+
 def _one_run(
     client: Any, workers: int, recording: Path, cache: Path, configs: Any, grid: Any
 ) -> dict[str, Any]:
+    from dask.utils import key_split
     from distributed import get_task_stream
 
     load_before = os.getloadavg()[0]
+    tasks0 = _task_cpu(client)
     cpu0 = _process_cpu(client, workers == 1)
     start = time.perf_counter()
     with get_task_stream(client) as stream:
         result = run_sweep([recording], grid, configs, client, cache_root=cache)
     wall = time.perf_counter() - start
     cpu = _process_cpu(client, workers == 1) - cpu0
+    tasks1 = _task_cpu(client)
+    task_cpu = {k: round(v - tasks0.get(k, 0.0), 3) for k, v in tasks1.items()}
+    task_cpu = {k: v for k, v in task_cpu.items() if v > 0}
+    counts: dict[str, int] = {}
+    for rec in stream.data:
+        prefix = key_split(rec["key"]).lstrip("_")
+        counts[prefix] = counts.get(prefix, 0) + 1
+    graph = _sweep_graph(task_cpu, counts)
     if result.failures:
         raise SystemExit(f"sweep failed: {result.failures[0].error}")
     return {
@@ -111,15 +189,21 @@ def _one_run(
         "track_task_s": round(result.track_seconds, 3),
         "cache_hits": result.cache_hits,
         "records": [(r.point, r.counts) for r in result.records],
+        "task_cpu_s": task_cpu,
+        "task_counts": counts,
+        # Idle-machine makespans of this run's graph from its tasks' CPU seconds.
+        "estimate_1_s": round(_schedule(graph, 1), 3),
+        "estimate_2_s": round(_schedule(graph, 2), 3),
         **_stream_stats(stream.data),
     }
 
 
 def _summary(runs: list[dict[str, Any]]) -> dict[str, float]:
-    return {
-        k: round(statistics.median(r[k] for r in runs), 3)
-        for k in ("wall_s", "cpu_s", "makespan_s", "utilisation", "load_before")
-    }
+    keys = ("wall_s", "cpu_s", "makespan_s", "utilisation", "load_before")
+    out = {k: round(statistics.median(r[k] for r in runs), 3) for k in keys}
+    for k in ("estimate_1_s", "estimate_2_s"):
+        out[k] = round(statistics.median(r[k] for r in runs), 3)
+    return out
 
 
 def main() -> int:
@@ -168,7 +252,9 @@ def main() -> int:
                             f"cpu {run['cpu_s']:6.2f} s  load {run['load_before']:5.2f}"
                             f"->{run['load_after']:5.2f}  busy {run['busy_s']} of makespan "
                             f"{run['makespan_s']:.2f} s (utilisation {run['utilisation']:.2f}), "
-                            f"{run['tasks']} tasks, cache hits {run['cache_hits']}"
+                            f"{run['tasks']} tasks, cache hits {run['cache_hits']}; "
+                            f"task CPU {run['task_cpu_s']}; idle estimate on 1 / 2 slots "
+                            f"{run['estimate_1_s']:.2f} / {run['estimate_2_s']:.2f} s"
                         )
     finally:
         shutil.rmtree(scratch, ignore_errors=True)
@@ -178,22 +264,23 @@ def main() -> int:
     for mode in ("cold", "warm"):
         one, two = _summary(runs[(mode, 1)]), _summary(runs[(mode, 2)])
         wall_ratio = one["wall_s"] / two["wall_s"]
-        # CPU seconds of local:1 over the CPU seconds local:2 needs per busy worker slot.
-        estimate = one["cpu_s"] / (two["cpu_s"] / (2 * two["utilisation"]))
         with_startup = (one["wall_s"] + startup[1]) / (two["wall_s"] + startup[2])
+        # Idle machine: local:1's graph on one slot over local:2's graph on two, every task
+        # taking the thread CPU seconds it took in its run.
+        estimate = one["estimate_1_s"] / two["estimate_2_s"]
         summary[mode] = {
             "local1": one,
             "local2": two,
             "wall_ratio": round(wall_ratio, 3),
             "wall_ratio_with_startup": round(with_startup, 3),
-            "cpu_estimate_ratio": round(estimate, 3),
+            "estimate_ratio": round(estimate, 3),
         }
         print(
             f"{mode}: wall {one['wall_s']:.2f} / {two['wall_s']:.2f} s = {wall_ratio:.2f}x "
-            f"({with_startup:.2f}x counting cluster start-up); CPU {one['cpu_s']:.2f} / "
-            f"{two['cpu_s']:.2f} s, utilisation of local:2 {two['utilisation']:.2f}: "
-            f"estimate at no load {estimate:.2f}x; load {one['load_before']:.1f} / "
-            f"{two['load_before']:.1f}"
+            f"({with_startup:.2f}x counting cluster start-up), load {one['load_before']:.1f} / "
+            f"{two['load_before']:.1f}; process CPU {one['cpu_s']:.2f} / {two['cpu_s']:.2f} s; "
+            f"task-stream utilisation of local:2 {two['utilisation']:.2f}; critical path from "
+            f"task CPU: {one['estimate_1_s']:.2f} / {two['estimate_2_s']:.2f} s = {estimate:.2f}x"
         )
     if args.json is not None:
         args.json.parent.mkdir(parents=True, exist_ok=True)
