@@ -125,6 +125,18 @@ def test_detection_in_chunks_equals_one_pass(
         assert pickle.dumps(a.detections) == pickle.dumps(b.detections)
 
 
+def test_a_bad_recording_fails_alike_in_chunks(client2: Any, tmp_path: Path) -> None:
+    bad = tmp_path / "broken.mcap"
+    bad.write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 64)  # magic, then nothing readable
+    grid, configs = grid_and_configs()
+    whole, split = (
+        run_sweep([bad], grid, configs, client2, cache_root=tmp_path, chunks=ChunkPlan(n, 1))
+        for n in (1, 3)
+    )
+    assert split.records == () and len(split.failures) == len(VALUES)
+    assert split.failures == whole.failures and split.failures[0].exit_code == 3
+
+
 def test_worker_killed_mid_sweep_is_replaced_and_the_sweep_completes(
     recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path
 ) -> None:
