@@ -5,7 +5,11 @@ task loads (or computes and stores) the detections of one sequence for one
 distinct detector config of the grid, and aligns the ground truth with them; a
 *track* task tracks and scores one (grid point, sequence) from its prepare
 task's result, which the scheduler hands from worker to worker. Tasks return
-records to the client; workers write nothing but cache entries.
+records to the client; workers write nothing but cache entries. With fewer
+recordings than workers, a miss is detected in frame chunks on several workers
+(:mod:`rgbd_eval.chunked`): the prepare task opens the recording, a chain of
+*advance* tasks hands each *chunk* task its detector state, a *join* task
+assembles and stores the detections, and the track tasks start from the join.
 
 A task that fails on bad input returns its error instead of raising, so the
 other points complete and the failure is reported with its grid point. A
