@@ -182,3 +182,39 @@ def test_concurrent_writers_leave_one_complete_entry(tmp_path: Path) -> None:
     loaded = cache.load(KEY)
     assert loaded is not None and same(loaded, value)
     assert len(list(cache.path(KEY).parent.iterdir())) == 1
+
+
+def test_recording_digest_is_memoised_by_file_identity(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    recording = tmp_path / "rec.mcap"
+    recording.write_bytes(b"abc")
+    cache = DetectionCache(tmp_path / "cache")
+    # sha256("abc"), the FIPS 180-2 example.
+    abc = "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad"
+    assert cache.digest(recording) == abc
+    memos = list((tmp_path / "cache" / "digests").iterdir())
+    assert len(memos) == 1 and memos[0].read_text() == abc + "\n"
+
+    # A second call reads the memo, not the recording.
+    def no_hashing(path: Path) -> str:
+        raise AssertionError(f"{path} hashed again")
+
+    monkeypatch.setattr("rgbd_eval.cache.file_digest", no_hashing)
+    assert cache.digest(recording) == abc
+    monkeypatch.undo()
+    # Rewritten (size and ctime change): hashed again; sha256("abcd").
+    recording.write_bytes(b"abcd")
+    assert cache.digest(recording) == hashlib.sha256(b"abcd").hexdigest()
+    # A memo that does not hold a digest is recomputed and rewritten.
+    for memo in (tmp_path / "cache" / "digests").iterdir():
+        memo.write_text("not a digest\n")
+    assert cache.digest(recording) == hashlib.sha256(b"abcd").hexdigest()
+    texts = {m.read_text() for m in (tmp_path / "cache" / "digests").iterdir()}
+    # The memo of the old content ("abc") is still junk: nothing looked it up.
+    assert texts == {"not a digest\n", hashlib.sha256(b"abcd").hexdigest() + "\n"}
+
+
+def test_digest_of_a_missing_recording_is_an_os_error(tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        DetectionCache(tmp_path / "cache").digest(tmp_path / "missing.mcap")

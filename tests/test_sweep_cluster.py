@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import pickle
 import signal
 from collections.abc import Iterator
 from pathlib import Path
@@ -14,6 +15,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rgbd_eval.cache import DetectionCache, detection_key
+from rgbd_eval.chunked import ChunkPlan
 from rgbd_eval.cli.main import app
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.datasets import scenarios_dir
@@ -98,6 +100,41 @@ def test_two_workers_equal_one_bit_for_bit(
     assert dump == [
         json.dumps(r.counts.__dict__, sort_keys=True, default=str) for r in reference.records
     ]
+
+
+def test_detection_in_chunks_equals_one_pass(
+    recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path
+) -> None:
+    """Each recording detected in 3 chunks of 3 or more frames (12 -> 4+4+4, 10 -> 3+3+4)
+    on the two workers: the same detections in the cache entries, and the same records."""
+    grid, configs = grid_and_configs()
+    plan = ChunkPlan(3, 3)
+    cold = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
+    warm = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
+    assert (cold.cache_misses, warm.cache_hits, cold.failures) == (2, 2, ())
+    assert records(cold) == records(reference) and records(warm) == records(reference)
+    # Against one pass on local:1 (one worker: no chunks); the entries differ only in the
+    # stage seconds they record.
+    one = tmp_path / "one-pass"
+    run_sweep(recordings, grid, configs, cache_root=one)
+    for entry in (tmp_path / "detections").rglob("*.det"):
+        twin = one / entry.relative_to(tmp_path)
+        a, b = (DetectionCache(root).load(entry.stem) for root in (tmp_path, one))
+        assert twin.exists() and a is not None and b is not None
+        assert a.stamps_ns == b.stamps_ns
+        assert pickle.dumps(a.detections) == pickle.dumps(b.detections)
+
+
+def test_a_bad_recording_fails_alike_in_chunks(client2: Any, tmp_path: Path) -> None:
+    bad = tmp_path / "broken.mcap"
+    bad.write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 64)  # magic, then nothing readable
+    grid, configs = grid_and_configs()
+    whole, split = (
+        run_sweep([bad], grid, configs, client2, cache_root=tmp_path, chunks=ChunkPlan(n, 1))
+        for n in (1, 3)
+    )
+    assert split.records == () and len(split.failures) == len(VALUES)
+    assert split.failures == whole.failures and split.failures[0].exit_code == 3
 
 
 def test_worker_killed_mid_sweep_is_replaced_and_the_sweep_completes(

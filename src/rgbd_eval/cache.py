@@ -34,6 +34,7 @@ from rgbd_eval import __version__
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import CacheError
 from rgbd_eval.pipeline import SequenceDetections
+from rgbd_eval.report import file_digest
 from rgbd_eval.types import Box2D, Box3D, Detection
 
 #: Bump when the Detection layout or the detector's behaviour changes incompatibly.
@@ -194,6 +195,17 @@ def _xyz(values: list[float]) -> tuple[float, float, float]:
     return (values[0], values[1], values[2])
 
 
+def _stat_identity(path: Path) -> list[list[Any]]:
+    """What identifies a recording's bytes without reading them: per file, its path,
+    size, mtime_ns, ctime_ns, inode and device."""
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    out = []
+    for f in files:
+        st = f.stat()
+        out.append([str(f), st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino, st.st_dev])
+    return out
+
+
 class DetectionCache:
     """Load and store :class:`SequenceDetections` by key under ``root``."""
 
@@ -201,6 +213,29 @@ class DetectionCache:
         self.root = Path(root) if root is not None else default_cache_dir()
         if self.root.exists() and not self.root.is_dir():
             raise CacheError(self.root, "is a file, not a detection cache folder")
+
+    def digest(self, recording: Path) -> str:
+        """The recording's :func:`~rgbd_eval.report.file_digest`, memoised under ``digests/``
+        by the files' (path, size, mtime_ns, ctime_ns, inode, device): a warm sweep does
+        not read every recording again. A memo that does not parse is recomputed; OSError
+        when the recording cannot be read."""
+        recording = recording.resolve()
+        identity = json.dumps(_stat_identity(recording)).encode()
+        memo = self.root / "digests" / f"{hashlib.sha256(identity).hexdigest()}.sha256"
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            text = memo.read_text(encoding="ascii").strip()
+            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
+                return text
+        digest = file_digest(recording)
+        tmp = memo.with_name(f".{memo.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
+        try:  # a memo that cannot be written costs a re-hash next time, nothing else
+            memo.parent.mkdir(parents=True, exist_ok=True)
+            tmp.write_text(digest + "\n", encoding="ascii")
+            os.replace(tmp, memo)
+        except OSError:
+            with contextlib.suppress(OSError):
+                tmp.unlink()
+        return digest
 
     def path(self, key: str) -> Path:
         """Where the entry of ``key`` lives."""

@@ -117,7 +117,19 @@ def _local(spec: ClusterSpec) -> Iterator[Client]:
     except (OSError, RuntimeError) as err:  # RuntimeError: "Nanny failed to start."
         raise ClusterError(f"cannot start a {spec.describe()}: {err}") from err
     with cluster, Client(cluster, set_as_default=False) as client:
+        if spec.workers > 1:
+            client.run(_warm_up)
         yield client
+
+
+def _warm_up() -> None:
+    """Import the task code and every registered method in a new worker process, all workers
+    at once while the cluster starts, rather than in each worker's first task (measured
+    here: 0.9 CPU s to import the sweep's modules, 0.85 s the methods)."""
+    from rgbd_eval.plugins import load_plugins
+    from rgbd_eval.sweep import run_sweep  # noqa: F401  # the task functions' module
+
+    load_plugins()
 
 
 def map_ordered(

@@ -13,7 +13,7 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from rgbd_eval.config import Gating, RunConfig
-from rgbd_eval.detect.protocol import create_detector
+from rgbd_eval.detect.protocol import ResumableDetector, create_detector
 from rgbd_eval.errors import ConfigError, GroundTruthError, InputError, ScoringError
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
 from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
@@ -91,9 +91,15 @@ def _add_stages(
 
 
 def _detect_frames(
-    recording: Recording, config: RunConfig, seconds: dict[str, float], stages: dict[str, float]
+    recording: Recording,
+    config: RunConfig,
+    seconds: dict[str, float],
+    stages: dict[str, float],
+    span: tuple[int, int] | None = None,
+    state: object | None = None,
 ) -> Iterator[tuple[Frame, tuple[Detection, ...]]]:
-    """``(frame, detections)`` of every frame from a fresh detector.
+    """``(frame, detections)`` of every frame (or of frames ``span``) from a fresh detector
+    (restored to ``state``, see :class:`~rgbd_eval.detect.protocol.ResumableDetector`).
 
     Adds the seconds spent reading and detecting to ``seconds["read"]`` and
     ``seconds["detect"]``, and the detector's own stages (:attr:`Detector.last_timings`,
@@ -101,8 +107,12 @@ def _detect_frames(
     frames is counted in neither.
     """
     detector = create_detector(config)
+    if state is not None:
+        if not isinstance(detector, ResumableDetector):
+            raise ConfigError(f"detector {config.detector.name!r} cannot resume from a state")
+        detector.restore_state(state)
     start = time.perf_counter()
-    for frame in recording.frames():
+    for frame in recording.frames(*(span or (0, len(recording)))):
         t0 = time.perf_counter()
         dets = tuple(detector.detect(frame))
         t1 = time.perf_counter()
@@ -118,14 +128,21 @@ def _stage_seconds(seconds: dict[str, float], stages: dict[str, float]) -> dict[
 
 
 def detect_sequence(
-    recording: Recording, config: RunConfig, progress: Progress | None = None
+    recording: Recording,
+    config: RunConfig,
+    progress: Progress | None = None,
+    span: tuple[int, int] | None = None,
+    state: object | None = None,
 ) -> SequenceDetections:
-    """Run the configured detector on every frame (a fresh detector per sequence)."""
+    """Run the configured detector on every frame (a fresh detector per sequence).
+
+    ``span`` and ``state``: frames ``start:stop`` only, from a detector resumed at ``state``.
+    """
     seconds = {"read": 0.0, "detect": 0.0}
     stages: dict[str, float] = {}
     stamps: list[int] = []
     per_frame: list[tuple[Detection, ...]] = []
-    for frame, dets in _detect_frames(recording, config, seconds, stages):
+    for frame, dets in _detect_frames(recording, config, seconds, stages, span, state):
         stamps.append(frame.stamp_ns)
         per_frame.append(dets)
         if progress is not None:

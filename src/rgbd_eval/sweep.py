@@ -5,7 +5,11 @@ task loads (or computes and stores) the detections of one sequence for one
 distinct detector config of the grid, and aligns the ground truth with them; a
 *track* task tracks and scores one (grid point, sequence) from its prepare
 task's result, which the scheduler hands from worker to worker. Tasks return
-records to the client; workers write nothing but cache entries.
+records to the client; workers write nothing but cache entries. With fewer
+recordings than workers, a miss is detected in frame chunks on several workers
+(:mod:`rgbd_eval.chunked`): the prepare task opens the recording, a chain of
+*advance* tasks hands each *chunk* task its detector state, a *join* task
+assembles and stores the detections, and the track tasks start from the join.
 
 A task that fails on bad input returns its error instead of raising, so the
 other points complete and the failure is reported with its grid point. A
@@ -40,9 +44,12 @@ from rgbd_eval.cache import (
     detector_inputs,
     encode,
 )
+from rgbd_eval.chunked import Chunk, ChunkPlan, advance, detect_chunk, join, resumable
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
 from rgbd_eval.engine import ClusterSpec, connect, killed_worker_message
 from rgbd_eval.errors import ClusterError, ConfigError, InputError, RgbdEvalError, ScoringError
+from rgbd_eval.io.groundtruth import GroundTruth
+from rgbd_eval.io.reader import Recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,
@@ -197,6 +204,17 @@ class _Prepared:
 
 
 @dataclass(frozen=True)
+class _Opened:
+    """A cache miss to detect in chunks: the recording, opened once for its chunk tasks."""
+
+    key: str
+    recording: Recording
+    ground_truth: GroundTruth
+    seconds: float
+    rejected: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class _Brief:
     """What the client needs of a prepare task (not the detections, unless it stores them)."""
 
@@ -206,6 +224,10 @@ class _Brief:
     failed: _Failed | None
 
 
+def _failed(err: RgbdEvalError) -> _Failed:
+    return _Failed(" ".join(str(err).split()), err.exit_code)
+
+
 def _prepare(
     path: Path,
     digest: str | None,
@@ -213,18 +235,23 @@ def _prepare(
     gt_path: Path | None,
     cache_root: Path | None,
     cached: SequenceDetections | None,
-) -> _Prepared | _Failed:
+    chunked: bool = False,
+) -> _Prepared | _Opened | _Failed:
     """Detections (cache, ``cached`` from the client, or fresh) and aligned ground truth.
 
-    ``digest`` is the recording's :func:`file_digest`, computed here when None.
+    ``digest`` is the recording's :func:`file_digest`, computed (or found in the cache's
+    digest memo) here when None. With ``chunked``, a miss returns the opened recording
+    for :func:`_advance`, :func:`_detect_chunk` and :func:`_join` instead of detecting.
     """
     start = time.perf_counter()
     try:
+        cache = DetectionCache(cache_root) if cache_root is not None else None
         try:
-            key = detection_key(digest or file_digest(path), config)
+            if digest is None:
+                digest = cache.digest(path) if cache is not None else file_digest(path)
+            key = detection_key(digest, config)
         except OSError as err:
             raise InputError(path, f"cannot read ({err.strerror or err})") from err
-        cache = DetectionCache(cache_root) if cache_root is not None else None
         detections = cached
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", CacheWarning)
@@ -242,6 +269,8 @@ def _prepare(
                 raise ScoringError(
                     f"{path}: a sweep needs ground truth (topic, <name>.gt.csv sidecar or --gt)"
                 )
+            if detections is None and chunked:
+                return _Opened(key, recording, gt, time.perf_counter() - start, rejected)
             if detections is None:
                 # Tracked in its encoded form, so that a later cache hit tracks the same numbers.
                 detections = decode(key, encode(key, detect_sequence(recording, config)))
@@ -249,8 +278,77 @@ def _prepare(
                     cache.store(key, detections)
         matched = match_ground_truth(gt, detections.stamps_ns, config)
     except RgbdEvalError as err:
-        return _Failed(" ".join(str(err).split()), err.exit_code)
+        return _failed(err)
     return _Prepared(path, key, detections, matched, time.perf_counter() - start, hit, rejected)
+
+
+#: A chunk task's input state: the detector's carried state (None: fresh), or why there is none.
+_State = object
+
+
+def _advance(
+    opened: _Prepared | _Opened | _Failed,
+    config: RunConfig,
+    plan: ChunkPlan,
+    k: int,
+    state: _State,
+) -> _State:
+    """The detector's state after chunk ``k`` (nothing to do unless ``opened`` is a miss)."""
+    if not isinstance(opened, _Opened) or isinstance(state, _Failed):
+        return state
+    try:
+        return advance(opened.recording, config, plan.spans(len(opened.recording))[k], state)
+    except RgbdEvalError as err:
+        return _failed(err)
+
+
+def _detect_chunk(
+    opened: _Prepared | _Opened | _Failed,
+    config: RunConfig,
+    plan: ChunkPlan,
+    k: int,
+    state: _State,
+) -> tuple[Chunk, float] | _Failed | None:
+    """Detections of chunk ``k`` from ``state``, and the task's seconds (None on a hit)."""
+    if not isinstance(opened, _Opened):
+        return None
+    if isinstance(state, _Failed):
+        return state
+    start = time.perf_counter()
+    try:
+        span = plan.spans(len(opened.recording))[k]
+        chunk = detect_chunk(opened.recording, config, span, state)
+    except RgbdEvalError as err:
+        return _failed(err)
+    return chunk, time.perf_counter() - start
+
+
+def _join(
+    path: Path,
+    opened: _Prepared | _Opened | _Failed,
+    config: RunConfig,
+    cache_root: Path | None,
+    *parts: tuple[Chunk, float] | _Failed | None,
+) -> _Prepared | _Failed:
+    """The prepare result of a chunked detection: the chunks joined, stored, and aligned."""
+    if not isinstance(opened, _Opened):
+        return opened
+    start = time.perf_counter()
+    try:
+        for part in parts:  # the first failing chunk in frame order, as one pass would fail
+            if isinstance(part, _Failed):
+                return part
+        chunks = [p for p in parts if isinstance(p, tuple)]
+        joined = join(opened.recording, [c for c, _ in chunks])
+        key = opened.key
+        detections = decode(key, encode(key, joined))
+        if cache_root is not None:
+            DetectionCache(cache_root).store(key, detections)
+        matched = match_ground_truth(opened.ground_truth, detections.stamps_ns, config)
+    except RgbdEvalError as err:
+        return _failed(err)
+    seconds = opened.seconds + sum(t for _, t in chunks) + time.perf_counter() - start
+    return _Prepared(path, key, detections, matched, seconds, False, opened.rejected)
 
 
 def _brief(prepared: _Prepared | _Failed) -> _Brief:
@@ -270,8 +368,37 @@ def _track(prepared: _Prepared | _Failed, config: RunConfig) -> tuple[Counts, fl
         tracks = track_sequence(prepared.detections, config, recording)
         scores = score_sequence(prepared.ground_truth, tracks, config)
     except RgbdEvalError as err:
-        return _Failed(" ".join(str(err).split()), err.exit_code)
+        return _failed(err)
     return scores.counts, time.perf_counter() - start
+
+
+def _worker_threads(client: Client) -> int:
+    """Task slots of the cluster (threads summed over its workers), at least 1."""
+    workers = client.scheduler_info().get("workers", {})
+    return max(1, sum(int(w.get("nthreads", 1)) for w in workers.values()))
+
+
+def _submit_chunks(
+    client: Client,
+    path: Path,
+    opened: Future[Any],
+    config: RunConfig,
+    plan: ChunkPlan,
+    cache_root: Path | None,
+) -> Future[Any]:
+    """The chunk tasks of one recording's detection; returns the future of their join.
+
+    The advance chain (each link the state after one more chunk) is submitted first,
+    so it runs ahead of the chunk detections that wait on it.
+    """
+    states: list[Any] = [None]
+    for k in range(plan.chunks - 1):
+        states.append(client.submit(_advance, opened, config, plan, k, states[-1], pure=False))
+    parts = [
+        client.submit(_detect_chunk, opened, config, plan, k, states[k], pure=False)
+        for k in range(plan.chunks)
+    ]
+    return client.submit(_join, path, opened, config, cache_root, *parts, pure=False)
 
 
 def _outcome(future: Future[Any]) -> Any:
@@ -293,17 +420,20 @@ def run_sweep(
     gt_path: Path | None = None,
     progress: Callable[[str, int, int], None] | None = None,
     cache_mode: CacheMode = CacheMode.SHARED,
+    chunks: ChunkPlan | None = None,
 ) -> SweepResult:
     """Run every grid point on every recording (see the module docstring).
 
     Without ``client``, a local cluster of one in-process worker runs the sweep.
     ``progress(stage, done, total)`` is called as tasks complete, stage
-    ``"detect"`` or ``"track+score"``.
+    ``"detect"`` or ``"track+score"``. ``chunks``: how a recording's detection is split
+    (:mod:`rgbd_eval.chunked`); by default into as many chunks as there are workers per
+    (recording, detector config), so one recording still keeps every worker busy.
     """
     if client is None:
         with connect(ClusterSpec(None, 1)) as own:
             return run_sweep(
-                recordings, grid, configs, own, cache_root, gt_path, progress, cache_mode
+                recordings, grid, configs, own, cache_root, gt_path, progress, cache_mode, chunks
             )
     from distributed import as_completed
 
@@ -311,8 +441,9 @@ def run_sweep(
     root = cache.root.resolve()  # workers may not share the client's working directory
     client_side = cache_mode is CacheMode.CLIENT
     # The client hashes the recordings only when it reads the cache itself; otherwise each
-    # prepare task hashes its recording on a worker, in parallel.
-    digests = {p: file_digest(p) for p in recordings} if client_side else {}
+    # prepare task hashes its recording on a worker, in parallel. Either way the digest is
+    # memoised in the cache folder, so a warm sweep reads no recording.
+    digests = {p: cache.digest(p) for p in recordings} if client_side else {}
     units = [
         (point, cfg, path) for point, cfg in zip(grid, configs, strict=True) for path in recordings
     ]
@@ -322,6 +453,8 @@ def run_sweep(
     groups: dict[tuple[Path, str], list[int]] = {}
     for i, (_, cfg, path) in enumerate(units):
         groups.setdefault((path, detector_inputs(cfg)), []).append(i)
+    if chunks is None:
+        chunks = ChunkPlan(max(1, _worker_threads(client) // max(1, len(groups))))
     prepared: dict[tuple[Path, str], Future[Any]] = {}
     briefs: dict[tuple[Path, str], Future[Any]] = {}
     tracked: dict[int, Future[Any]] = {}
@@ -334,16 +467,22 @@ def run_sweep(
                 warnings.simplefilter("always", CacheWarning)
                 cached = cache.load(detection_key(digests[path], cfg))
             rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
+        split = chunks.chunks > 1 and cached is None and resumable(cfg)
+        gt = gt_path.resolve() if gt_path is not None else None
+        cache_at = None if client_side else root
         prep = client.submit(
             _prepare,
             path.resolve(),
             digests.get(path),
             cfg,
-            gt_path.resolve() if gt_path is not None else None,
-            None if client_side else root,
+            gt,
+            cache_at,
             client.scatter(cached) if cached is not None else None,
+            split,
             pure=False,
         )
+        if split:
+            prep = _submit_chunks(client, path.resolve(), prep, cfg, chunks, cache_at)
         briefs[group] = client.submit(_brief, prep, pure=False)
         for i in members:
             tracked[i] = client.submit(_track, prep, units[i][1], pure=False)

@@ -56,7 +56,7 @@ from rgbd_eval.detect.features import (
     project_to_rgb,
     touches_border,
 )
-from rgbd_eval.detect.ground import GroundPlaneEstimator
+from rgbd_eval.detect.ground import GroundPlaneEstimator, GroundState
 from rgbd_eval.detect.hog import hog_confidences
 from rgbd_eval.detect.plane import signed_heights
 from rgbd_eval.errors import ConfigError
@@ -119,6 +119,29 @@ class Basso2012Detector:
     def ground_plane(self) -> FloatArray | None:
         """The current floor plane ``(a, b, c, d)`` in the depth optical frame (unit normal up)."""
         return self.ground.plane
+
+    @property
+    def advance_reads(self) -> frozenset[str]:
+        """:meth:`advance` reads the depth image alone (the colour camera's model, not its image)."""
+        return frozenset({"depth"})
+
+    def carry_state(self) -> GroundState:
+        """The ground plane's state: all :meth:`detect` carries from frame to frame."""
+        return self.ground.state()
+
+    def restore_state(self, state: object) -> None:
+        """Continue from :meth:`carry_state` of a detector of the same config."""
+        if not isinstance(state, GroundState):
+            raise TypeError(f"state must be a GroundState, got {type(state).__name__}")
+        self.ground.restore(state)
+
+    def advance(self, frame: Frame) -> None:
+        """The ground-plane stages of :meth:`detect` alone (point cloud, voxel grid, ground)."""
+        _check_depth(frame)
+        cloud = depth_to_cloud(
+            frame.depth, self._rays_for(frame.depth_camera), self.config.max_distance
+        )
+        self._ground_plane(frame, cloud, voxel_grid(cloud.points, self.config.voxel_size))
 
     def detect(self, frame: Frame) -> list[Detection]:
         """Detect people in one frame; detections in the world frame, nearest first."""
@@ -383,13 +406,18 @@ def _check_ground_pixels(cfg: Basso2012DetectorConfig, camera: CameraModel) -> N
         )
 
 
-def _check_frame(frame: Frame) -> None:
-    dc, rc = frame.depth_camera, frame.rgb_camera
+def _check_depth(frame: Frame) -> None:
+    dc = frame.depth_camera
     if frame.depth.shape != (dc.height, dc.width):
         raise ValueError(
             f"frame {frame.index}: depth image is {frame.depth.shape}, "
             f"depth camera is {dc.width}x{dc.height}"
         )
+
+
+def _check_frame(frame: Frame) -> None:
+    _check_depth(frame)
+    rc = frame.rgb_camera
     if frame.rgb.dtype != np.uint8 or frame.rgb.shape != (rc.height, rc.width, 3):
         raise ValueError(
             f"frame {frame.index}: rgb image is {frame.rgb.dtype} {frame.rgb.shape}, "

@@ -10,6 +10,7 @@ points are seen. Planes live in the depth camera's optical frame.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
@@ -104,6 +105,15 @@ def move_plane(plane: FloatArray, old_T_new: Pose) -> FloatArray:
     return normalise_plane((*(R.T @ normal), float(normal @ t) + float(plane[3])))
 
 
+@dataclass(frozen=True)
+class GroundState:
+    """What :class:`GroundPlaneEstimator` carries between frames (exact copies)."""
+
+    plane: FloatArray | None
+    inliers: int
+    last_pose: Pose | None
+
+
 class GroundPlaneEstimator:
     """Holds the plane from frame to frame; one instance per sequence."""
 
@@ -119,6 +129,17 @@ class GroundPlaneEstimator:
         elif config.ground_mode is GroundMode.POINTS and config.ground_points is not None:
             a, b, c = (np.asarray(p, dtype=np.float64) for p in config.ground_points)
             self.plane = plane_from_points(a, b, c)
+
+    def state(self) -> GroundState:
+        """A copy of the carried state."""
+        plane = None if self.plane is None else self.plane.copy()
+        return GroundState(plane, self.inliers, self._last_pose)
+
+    def restore(self, state: GroundState) -> None:
+        """Continue from :meth:`state` of an estimator of the same config."""
+        self.plane = None if state.plane is None else state.plane.copy()
+        self.inliers = state.inliers
+        self._last_pose = state.last_pose
 
     def initialise(
         self,

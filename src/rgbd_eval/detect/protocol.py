@@ -11,12 +11,17 @@ model, factory, the streams they read, their detection contract, their stages).
 Stage timing is part of the protocol: after each call, ``last_timings`` holds the
 seconds of each named stage (empty when the detector does not split its work), so
 ``bench`` lists any detector's stages.
+
+A detector whose state across frames is a small value that a cheaper pass over
+the frames can compute may say so (:class:`ResumableDetector`): a sweep then
+detects one recording in frame chunks on several workers, each chunk from the
+state a chain of those cheap passes hands it (:mod:`rgbd_eval.chunked`).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from rgbd_eval.config import RunConfig
 from rgbd_eval.plugins import detector_spec
@@ -33,6 +38,35 @@ class Detector(Protocol):
 
     def detect(self, frame: Frame) -> list[Detection]:
         """Detect the people in one frame."""
+        ...
+
+
+@runtime_checkable
+class ResumableDetector(Detector, Protocol):
+    """A detector that can start at any frame from the state it had there.
+
+    Contract: for a fresh detector A fed frames ``0..n-1`` with :meth:`detect`, and a
+    fresh detector B fed frames ``0..k-1`` with :meth:`advance`, then
+    ``C.restore_state(B.carry_state())`` on a fresh C fed frames ``k..n-1`` with
+    :meth:`detect`, C returns the very detections A returned for those frames, bit
+    for bit (tests/detect/test_resumable.py checks basso2012).
+    """
+
+    @property
+    def advance_reads(self) -> frozenset[str]:
+        """The roles whose images :meth:`advance` reads (the others are left undecoded)."""
+        ...
+
+    def carry_state(self) -> object:
+        """The state carried to the next frame (picklable, a copy)."""
+        ...
+
+    def restore_state(self, state: object) -> None:
+        """Continue from a state :meth:`carry_state` returned."""
+        ...
+
+    def advance(self, frame: Frame) -> None:
+        """Update the carried state over ``frame`` exactly as :meth:`detect` would, without detecting."""
         ...
 
 

@@ -20,7 +20,7 @@ Reading takes two passes, so memory stays flat in the sequence length:
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Collection, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -237,6 +237,10 @@ class _FramePlan:
     poses: Mapping[str, Pose]
 
 
+#: The image of a stream read with ``Recording.frames(skip=...)``.
+_NOT_DECODED = np.zeros((0, 0), dtype=np.uint8)
+
+
 class Recording:
     """An opened recording: its :class:`RecordingInfo` and its frame stream."""
 
@@ -270,15 +274,30 @@ class Recording:
     def frame_stamps(self) -> list[int]:
         return [p.stamp_ns for p in self._plan]
 
-    def frames(self) -> Iterator[Frame]:
-        """Decode and yield the synchronised frames in stamp order."""
+    def frames(
+        self, start: int = 0, stop: int | None = None, skip: Collection[str] = ()
+    ) -> Iterator[Frame]:
+        """Decode and yield the synchronised frames in stamp order.
+
+        ``start``/``stop`` choose frames ``start <= index < stop`` (the messages before
+        are skipped undecoded); a frame is the same whichever range it is read in.
+        The images of the roles in ``skip`` are not decoded: their streams keep camera,
+        stamp and pose, with a 0x0 image of encoding ``none``.
+        """
+        stop = len(self._plan) if stop is None else stop
+        if not 0 <= start <= stop <= len(self._plan):
+            raise ValueError(f"frame range {start}:{stop} outside 0:{len(self._plan)}")
+        if start == stop:
+            self.empty_depth_frames = []
+            return
         sel = self.info.selected.streams
         by_topic = {topic: role for role, topic in sel.items()}
-        wanted = {role: {p.messages[role]: k for k, p in enumerate(self._plan)} for role in sel}
+        span = range(start, stop)
+        wanted = {role: {self._plan[k].messages[role]: k for k in span} for role in sel}
         ready: dict[int, dict[str, Any]] = {}
         counters = dict.fromkeys(sel.values(), 0)
         primary = "depth" if "depth" in sel else next(iter(sel))
-        next_k = 0
+        next_k = start
         self.empty_depth_frames = []
         info = self.info
         try:
@@ -291,10 +310,13 @@ class Recording:
                     k = wanted[role].get(n)
                     if k is None:
                         continue
-                    msg = src.deserialize(raw, msgtypes[topic])
-                    decoded = self._decode(msg, topic, role, info.cameras[role])
-                    if role == "depth" and validate.depth_is_empty(decoded[0]):
-                        self.empty_depth_frames.append(k)
+                    if role in skip:
+                        decoded: tuple[Any, str] = (_NOT_DECODED, "none")
+                    else:
+                        msg = src.deserialize(raw, msgtypes[topic])
+                        decoded = self._decode(msg, topic, role, info.cameras[role])
+                        if role == "depth" and validate.depth_is_empty(decoded[0]):
+                            self.empty_depth_frames.append(k)
                     ready.setdefault(k, {})[role] = decoded
                     while len(ready.get(next_k, ())) == len(sel):
                         plan = self._plan[next_k]
@@ -319,14 +341,22 @@ class Recording:
                             has_odometry=info.has_odometry,
                         )
                         next_k += 1
+                    if next_k == stop:
+                        break
         except READ_ERRORS as err:
             raise InputError(self.path, f"read failed after {next_k} frames: {err}") from err
-        if next_k != len(self._plan):
+        if next_k != stop:
             raise InputError(
                 self.path, f"recording ended after {next_k} of {len(self._plan)} indexed frames"
             )
-        if next_k and len(self.empty_depth_frames) == next_k:
-            raise DecodeError(self.path, "no depth frame holds a valid pixel", sel["depth"])
+        if next_k and len(self.empty_depth_frames) == len(self._plan):
+            raise self.no_depth_error()
+
+    def no_depth_error(self) -> DecodeError:
+        """The error of a recording none of whose depth frames holds a valid pixel."""
+        return DecodeError(
+            self.path, "no depth frame holds a valid pixel", self.info.selected.streams["depth"]
+        )
 
     def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
         kind = role_kind(role)

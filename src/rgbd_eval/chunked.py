@@ -1,0 +1,114 @@
+"""Detecting one recording in frame chunks on several workers, bit-identical to one pass.
+
+basso2012 carries one thing from frame to frame: its ground plane, refined on
+every frame from the previous frame's plane (seed 000, 5.1 and 5.4.2), so frame
+k's detections depend on every frame before it, and a chunk cannot start from
+a fresh detector. But the plane comes from the cheap first stages of the
+detector alone (point cloud, voxel grid, ground: about a fifth of its time, the
+clustering, features and HOG that follow carry nothing), so the state at the
+start of chunk k is found by a chain of *advance* passes over chunks
+``0..k-1`` (:meth:`~rgbd_eval.detect.protocol.ResumableDetector.advance`),
+and each chunk is then detected in full from that state, in parallel with the
+rest of the chain. The joined chunks equal the sequential run bit for bit
+(tests/test_chunked.py). Detectors that are not resumable run in one piece.
+
+Cost: the chain re-reads and re-runs the ground stages of every chunk but the
+last: with K chunks, ``(K-1)/K`` of those stages again.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from rgbd_eval.config import RunConfig
+from rgbd_eval.detect.protocol import ResumableDetector, create_detector
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.io.reader import Recording
+from rgbd_eval.pipeline import SequenceDetections, detect_sequence
+
+#: Fewest frames worth a chunk of their own when the chunk count is chosen automatically:
+#: each chunk task re-creates its detector and skips the messages before its first frame.
+MIN_CHUNK_FRAMES = 60
+
+
+@dataclass(frozen=True)
+class ChunkPlan:
+    """Split a recording's detection into at most ``chunks`` pieces of ``min_frames`` or more."""
+
+    chunks: int
+    min_frames: int = MIN_CHUNK_FRAMES
+
+    def __post_init__(self) -> None:
+        if self.chunks < 1 or self.min_frames < 1:
+            raise ConfigError(
+                f"chunks ({self.chunks}) and min_frames ({self.min_frames}) must be at least 1"
+            )
+
+    def spans(self, frames: int) -> list[tuple[int, int]]:
+        """``chunks`` frame ranges covering ``0:frames`` in order; the tail ones empty when
+        the recording is too short for that many chunks of ``min_frames``."""
+        used = max(1, min(self.chunks, frames // self.min_frames))
+        bounds = [frames * i // used for i in range(used + 1)]
+        spans = list(itertools.pairwise(bounds))
+        return spans + [(frames, frames)] * (self.chunks - used)
+
+
+def resumable(config: RunConfig) -> bool:
+    """Whether the configured detector can be detected in chunks."""
+    return isinstance(create_detector(config), ResumableDetector)
+
+
+def advance(
+    recording: Recording, config: RunConfig, span: tuple[int, int], state: object | None
+) -> object:
+    """The detector's carried state after frames ``span``, starting from ``state``
+    (None: a fresh detector)."""
+    detector = create_detector(config)
+    if not isinstance(detector, ResumableDetector):
+        raise ConfigError(f"detector {config.detector.name!r} cannot resume from a state")
+    if state is not None:
+        detector.restore_state(state)
+    skip = set(recording.info.selected.streams) - detector.advance_reads
+    for frame in recording.frames(*span, skip=skip):
+        detector.advance(frame)
+    return detector.carry_state()
+
+
+@dataclass(frozen=True)
+class Chunk:
+    """The detections of one chunk, and how many of its depth frames held no valid pixel."""
+
+    detections: SequenceDetections
+    empty_depth_frames: int
+
+
+def detect_chunk(
+    recording: Recording, config: RunConfig, span: tuple[int, int], state: object | None
+) -> Chunk:
+    """Detections of frames ``span`` from a detector resumed at ``state`` (None: fresh)."""
+    detections = detect_sequence(recording, config, span=span, state=state)
+    return Chunk(detections, len(recording.empty_depth_frames))
+
+
+def join(recording: Recording, chunks: Sequence[Chunk]) -> SequenceDetections:
+    """The chunks of one recording, in order, as one :class:`SequenceDetections`.
+
+    Raises the recording's own error when no depth frame of any chunk held a valid
+    pixel, as a pass over the whole recording does.
+    """
+    frames = sum(len(c.detections.stamps_ns) for c in chunks)
+    if frames != len(recording):
+        raise ValueError(f"chunks hold {frames} of {len(recording)} frames")
+    if frames and sum(c.empty_depth_frames for c in chunks) == frames:
+        raise recording.no_depth_error()
+    seconds: dict[str, float] = {}
+    for c in chunks:
+        for name, value in c.detections.seconds.items():
+            seconds[name] = seconds.get(name, 0.0) + value
+    return SequenceDetections(
+        stamps_ns=tuple(s for c in chunks for s in c.detections.stamps_ns),
+        detections=tuple(d for c in chunks for d in c.detections.detections),
+        seconds=seconds,
+    )
