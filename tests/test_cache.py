@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import hashlib
 import io
+import os
 import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from rgbd_eval.cache import DetectionCache, decode, encode
+from rgbd_eval.cache import DetectionCache, decode, detection_key, encode
+from rgbd_eval.config import load_config
 from rgbd_eval.errors import CacheError
 from rgbd_eval.pipeline import SequenceDetections
 from rgbd_eval.types import Box2D, Box3D, Detection
@@ -218,3 +220,24 @@ def test_recording_digest_is_memoised_by_file_identity(
 def test_digest_of_a_missing_recording_is_an_os_error(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         DetectionCache(tmp_path / "cache").digest(tmp_path / "missing.mcap")
+
+
+def test_key_follows_the_contents_of_files_the_detector_reads(tmp_path: Path) -> None:
+    # A model replaced in place keeps its path; the cached detections of the old model
+    # must not be reused, so the key hashes the file (and a byte-equal copy elsewhere
+    # still differs by its path, which is part of the config).
+    model = tmp_path / "person.onnx"
+    model.write_bytes(b"model one")
+    config = load_config(
+        method="pinto2022",
+        overrides=["detector.person.backend=onnx", f"detector.person.model={model}"],
+    )
+    first = detection_key("0" * 64, config)
+    assert detection_key("0" * 64, config) == first  # deterministic
+    model.write_bytes(b"model two")
+    os.utime(model, ns=(1, 1))  # a new stat identity, as any rewrite gives
+    second = detection_key("0" * 64, config)
+    assert second != first
+    model.write_bytes(b"model one")
+    os.utime(model, ns=(2, 2))
+    assert detection_key("0" * 64, config) == first  # the contents, not the history

@@ -1,7 +1,7 @@
 """Content-addressed on-disk cache of detections, safe to share between processes and machines.
 
 Detections are a pure function of (recording, io config, detector config: its
-``name`` included), so a sweep over tracker parameters runs detection once per
+``name`` included, and the contents of the files it names, such as a model), so a sweep over tracker parameters runs detection once per
 sequence. The key is the sha256 of exactly those inputs (:func:`detection_key`).
 
 An entry is one file, ``detections/<key[:2]>/<key>.det``: a magic line, the
@@ -17,13 +17,16 @@ recomputed and overwritten, with a warning; it is never trusted.
 from __future__ import annotations
 
 import contextlib
+import functools
 import hashlib
 import io
 import json
 import os
+import stat
 import uuid
 import warnings
 import zipfile
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -52,6 +55,42 @@ def default_cache_dir() -> Path:
     return Path(os.environ.get("RGBD_EVAL_CACHE", ".cache/rgbd-eval"))
 
 
+def _paths(value: object, where: str = "detector") -> Iterator[tuple[str, Path]]:
+    """Every path-valued setting in a dumped config, with its dotted key."""
+    if isinstance(value, Path):
+        yield where, value
+    elif isinstance(value, dict):
+        for k, v in value.items():
+            yield from _paths(v, f"{where}.{k}")
+    elif isinstance(value, list | tuple):
+        for i, v in enumerate(value):
+            yield from _paths(v, f"{where}.{i}")
+
+
+@functools.lru_cache(maxsize=64)
+def _file_sha256(path: Path, size: int, mtime_ns: int, inode: int) -> str:
+    """sha256 of a file the detector reads, memoised per process by its stat identity."""
+    return file_digest(path)
+
+
+def _detector_files(config: RunConfig) -> dict[str, str]:
+    """sha256 of each file the detector's settings name (models, recorded detections).
+
+    Detections depend on a model's contents, not on its path: a file replaced in place
+    must not reuse the old entries. A path that does not name a readable file is left
+    to the detector to refuse.
+    """
+    out: dict[str, str] = {}
+    for key, path in _paths(config.detector.model_dump(mode="python")):
+        try:
+            st = path.stat()
+            if stat.S_ISREG(st.st_mode):
+                out[key] = _file_sha256(path.resolve(), st.st_size, st.st_mtime_ns, st.st_ino)
+        except OSError:
+            continue
+    return out
+
+
 def detector_inputs(config: RunConfig) -> str:
     """What detections depend on besides the recording, as canonical JSON."""
     payload = {
@@ -59,6 +98,7 @@ def detector_inputs(config: RunConfig) -> str:
         "tool": __version__,
         "io": config.io.model_dump(mode="json"),
         "detector": config.detector.model_dump(mode="json"),
+        "files": _detector_files(config),
     }
     return json.dumps(payload, sort_keys=True)
 
