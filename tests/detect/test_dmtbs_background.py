@@ -30,14 +30,31 @@ def test_running_average_rules_pixel_by_pixel() -> None:
     # p0: 2.1 - 1.9 = 0.2 > 0.1 -> foreground; B = 2.1 + (1.9 - 2.1) / 2 = 2.0.
     # p1: infinitely far background -> foreground; seen once (adopted after 2 in a row).
     # p2: invalid -> not foreground, B kept at 3.0.
-    # p3: 1.5 is farther: average 1.25, and 1.5 - 1.25 = 0.25 > 0.1 -> revealed, B = 1.5.
+    # p3: 1.5 is farther: average 1.25, and 1.5 - 1.25 = 0.25 > 0.1, farther once (of 2).
     np.testing.assert_array_equal(fg, [[True, True, False, False]])
-    np.testing.assert_allclose(bg.background, _row(2.0, np.inf, 3.0, 1.5), rtol=1e-6)
+    np.testing.assert_allclose(bg.background, _row(2.0, np.inf, 3.0, 1.25), rtol=1e-6)
     fg = bg.apply(_row(2.0, 2.5, 3.0, 1.5), 0.1)
     # p1 valid for the second frame in a row: still foreground now, then adopted as 2.5.
+    # p3: average 1.25 + (1.5 - 1.25) / 2 = 1.375, 1.5 - 1.375 = 0.125 > 0.1, farther for
+    # the second frame in a row -> revealed, B = 1.5.
     np.testing.assert_array_equal(fg, [[False, True, False, False]])
     np.testing.assert_allclose(bg.background, _row(2.0, 2.5, 3.0, 1.5), rtol=1e-6)
     assert not bg.apply(_row(2.0, 2.5, 3.0, 1.5), 0.1).any()
+
+
+def test_one_far_noise_sample_does_not_move_the_background() -> None:
+    bg = RunningAverageBackground(init_frames=3, time_constant_s=HALF_TAU, margin_m=0.1)
+    for _ in range(3):
+        bg.apply(_row(2.0), 0.1)
+    # One sample 0.3 m too far (noise): average 2.15, farther by 0.15 once (of 3): B = 2.15,
+    # not 2.3 -> the next ordinary sample (2.0) is 0.15 nearer: foreground this once, and
+    # B averages back to 2.075, the one after that is background again (0.075 < 0.1).
+    assert not bg.apply(_row(2.3), 0.1).any()
+    assert bg.background is not None and float(bg.background[0, 0]) == pytest.approx(2.15)
+    assert bg.apply(_row(2.0), 0.1).all()
+    assert not bg.apply(_row(2.0), 0.1).any()
+    # Had B jumped to 2.3 (adopting single far samples), 2.0 would have been foreground for
+    # two frames (2.3 -> 2.15 -> 2.075), and every far sample would start that again.
 
 
 def test_weight_follows_the_time_step() -> None:
