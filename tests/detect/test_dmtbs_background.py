@@ -132,3 +132,22 @@ def test_mog2_does_not_flag_a_revealed_farther_surface() -> None:
     fg = bg.apply(z, 1 / 30)
     assert not fg[10:20, 10:20].any()
     assert fg[25:35, 25:35].all()
+
+
+def test_mog2_finds_an_object_in_front_of_pixels_that_never_return() -> None:
+    # The top rows never return (the void above a floor's far edge); an object appears there.
+    # They must count as infinitely far: had they entered as 0 m, the object (2 m) would lie
+    # farther than that background and never be foreground.
+    rng = np.random.default_rng(7)
+    bg = Mog2Background(10, 3.0, 16.0, 0.05**2, 0.01**2, 0.2**2)
+    for _ in range(20):
+        z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+        z[:10] = np.nan
+        assert not bg.apply(z, 1 / 30).any()
+    z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+    z[:10] = np.nan
+    z[2:8, 15:25] = 2.0
+    fg = bg.apply(z, 1 / 30)
+    assert fg[2:8, 15:25].all()
+    fg[2:8, 15:25] = False
+    assert not fg.any()

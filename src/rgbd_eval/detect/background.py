@@ -166,11 +166,20 @@ _running_average_kernel: Callable[
 ] = numba.njit(cache=True)(_running_average_step)
 
 
+#: The value MOG2 sees at invalid pixels (m): farther than any depth camera's range, as the
+#: running average's infinitely far background; within [0, 255], the range OpenCV documents
+#: for floating-point frames.
+NO_RETURN_M = 100.0
+
+
 class Mog2Background:
     """OpenCV's MOG2 with two mixtures on the depth image in metres (seed 003, Fig. 10).
 
-    Invalid pixels enter as 0 m (a value of their own) and are never foreground; nor is what
-    lies farther than MOG2's background image (a revealed surface, not an object); MOG2's
+    Invalid pixels ("no return") enter as :data:`NO_RETURN_M`, farther than anything a depth
+    camera measures, and are never foreground; nor is what lies farther than MOG2's background
+    image (a revealed surface, not an object). Entering them as 0 m instead made a pixel that
+    never returns (the void above a floor's far edge) a background at 0 m, nearer than any
+    person, so that people seen against it were never foreground. MOG2's
     variances are set in metres squared (its defaults are for 8-bit intensities). The
     learning rate follows the same time constant as the running average; the first
     ``init_frames`` frames learn with rate ``1/n`` (a plain mean) and report no foreground.
@@ -208,7 +217,7 @@ class Mog2Background:
     def apply(self, depth: DepthImage, dt_s: float) -> BoolImage:
         z = np.asarray(depth, dtype=np.float32)
         valid = np.isfinite(z)
-        image = np.where(valid, z, np.float32(0.0)).astype(np.float32)
+        image = np.where(valid, z, np.float32(NO_RETURN_M)).astype(np.float32)
         self.frames += 1
         if self.frames <= self.init_frames:
             self._mog.apply(image, learningRate=1.0 / self.frames)
