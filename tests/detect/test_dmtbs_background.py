@@ -151,3 +151,27 @@ def test_mog2_finds_an_object_in_front_of_pixels_that_never_return() -> None:
     assert fg[2:8, 15:25].all()
     fg[2:8, 15:25] = False
     assert not fg.any()
+
+
+def test_mog2_keeps_the_background_of_pixels_with_dropouts() -> None:
+    # Two frames in three the left half drops out (flying pixels, dark material). The dropouts
+    # must not take one of MOG2's two modes: when an object passes (frames 40-49) and leaves,
+    # the wall (3 m) must still be the background, not foreground.
+    rng = np.random.default_rng(11)
+    bg = Mog2Background(10, 3.0, 16.0, 0.05**2, 0.01**2, 0.2**2)
+
+    def wall(k: int) -> np.ndarray:
+        z = (3.0 + 0.005 * rng.standard_normal((20, 20))).astype(np.float32)
+        if k % 3 != 0:
+            z[:, :10] = np.nan
+        return z
+
+    for k in range(40):
+        bg.apply(wall(k), 1 / 30)
+    for k in range(40, 50):
+        z = wall(k)
+        z[5:15, 5:15] = 1.8 + 0.02 * (k - 40)  # an object walking through, 1.8-2.0 m
+        bg.apply(z, 1 / 30)
+    for k in range(50, 60):
+        fg = bg.apply(wall(k), 1 / 30)
+        assert not fg.any()

@@ -166,20 +166,24 @@ _running_average_kernel: Callable[
 ] = numba.njit(cache=True)(_running_average_step)
 
 
-#: The value MOG2 sees at invalid pixels (m): farther than any depth camera's range, as the
-#: running average's infinitely far background; within [0, 255], the range OpenCV documents
-#: for floating-point frames.
+#: The value MOG2 sees at a pixel never valid (m): farther than any depth camera's range, as
+#: the running average's infinitely far background; within [0, 255], the range OpenCV
+#: documents for floating-point frames.
 NO_RETURN_M = 100.0
 
 
 class Mog2Background:
     """OpenCV's MOG2 with two mixtures on the depth image in metres (seed 003, Fig. 10).
 
-    Invalid pixels ("no return") enter as :data:`NO_RETURN_M`, farther than anything a depth
-    camera measures, and are never foreground; nor is what lies farther than MOG2's background
-    image (a revealed surface, not an object). Entering them as 0 m instead made a pixel that
-    never returns (the void above a floor's far edge) a background at 0 m, nearer than any
-    person, so that people seen against it were never foreground. MOG2's
+    An invalid pixel carries no information (as in the running average): MOG2 sees the
+    pixel's last valid depth again, or :data:`NO_RETURN_M` (farther than any depth camera's
+    range) if it has never been valid; it is never foreground. Nor is what lies farther than
+    MOG2's background image (a revealed surface, not an object). Two other encodings failed
+    on scene 2: 0 m made a pixel that never returns (the void above the floor's far edge) a
+    background nearer than any person, so people seen against it were never foreground; a
+    fixed far value made every pixel with occasional dropouts spend one of its two modes on
+    that value, so that the first person to pass replaced the true background's mode, which
+    was foreground from then on. MOG2's
     variances are set in metres squared (its defaults are for 8-bit intensities). The
     learning rate follows the same time constant as the running average; the first
     ``init_frames`` frames learn with rate ``1/n`` (a plain mean) and report no foreground.
@@ -213,11 +217,16 @@ class Mog2Background:
         mog.setVarMin(var_min_m2)
         mog.setVarMax(var_max_m2)
         self._mog = mog
+        #: per pixel, the depth MOG2 last saw (an invalid pixel repeats it)
+        self._last: DepthImage | None = None
 
     def apply(self, depth: DepthImage, dt_s: float) -> BoolImage:
         z = np.asarray(depth, dtype=np.float32)
         valid = np.isfinite(z)
-        image = np.where(valid, z, np.float32(NO_RETURN_M)).astype(np.float32)
+        if self._last is None or self._last.shape != z.shape:
+            self._last = np.full(z.shape, NO_RETURN_M, dtype=np.float32)
+        image = np.where(valid, z, self._last).astype(np.float32)
+        self._last = image
         self.frames += 1
         if self.frames <= self.init_frames:
             self._mog.apply(image, learningRate=1.0 / self.frames)
