@@ -143,10 +143,12 @@ def depth_noise(
     trk: DmtbsTrackerConfig,
     levels_m: list[float],
     seed: int,
+    mog2: bool = True,
 ) -> list[dict[str, Any]]:
-    """Fig. 10: added Gaussian noise, with the running average and with MOG2."""
+    """Fig. 10: added Gaussian noise, with the running average and (``mog2``) with MOG2."""
     rows = []
-    for method in (BackgroundMethod.RUNNING_AVERAGE, BackgroundMethod.MOG2):
+    methods = [BackgroundMethod.RUNNING_AVERAGE] + ([BackgroundMethod.MOG2] if mog2 else [])
+    for method in methods:
         config = det.model_copy(update={"background": method})
         for sigma in levels_m:
             run = run_frames(with_noise(frames, sigma, seed), cameras, config, trk)
