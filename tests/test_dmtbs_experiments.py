@@ -9,8 +9,15 @@ import pytest
 
 from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
 from rgbd_eval.methods.dmtbs import check_claims
-from rgbd_eval.methods.dmtbs_experiments import arc_camera, run_frames, with_noise, yaw_error
+from rgbd_eval.methods.dmtbs_experiments import (
+    arc_camera,
+    left_object_frames,
+    run_frames,
+    with_noise,
+    yaw_error,
+)
 from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.tof import TofFrame, TofImage
 from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
 from rgbd_eval.types import GroundTruthObject, Pose
@@ -118,3 +125,37 @@ def test_arc_camera_looks_at_the_target_from_level_to_straight_down() -> None:
     np.testing.assert_allclose(np.array(pose.translation) + 5.0 * axis, [0, 0, 1], atol=1e-9)
     with pytest.raises(ValueError, match="angle_deg"):
         arc_camera(base, 95.0, (0.0, 0.0, 1.0), 5.0)
+
+
+def _box_scene() -> Scenario:
+    """A 32x24 camera 3 m above the floor looking down at a 1.5 m box; 6 frames at 30 Hz."""
+    return parse_scenario(
+        {
+            "name": "left_box",
+            "duration_s": 0.2,
+            "room": {"x_min": -2, "x_max": 2, "y_min": -2, "y_max": 2, "walls": False},
+            "obstacles": [{"kind": "box", "x": 0.0, "y": 0.0, "size": [0.5, 0.5, 1.5]}],
+            "rig": [
+                {
+                    "kind": "static_depth",
+                    "name": "top",
+                    "x": 0.0,
+                    "y": 0.0,
+                    "z": 3.0,
+                    "pitch_deg": 90.0,
+                    "width": 32,
+                    "height": 24,
+                }
+            ],
+        }
+    )
+
+
+def test_left_object_frames_show_the_object_from_its_time_on() -> None:
+    frames = list(left_object_frames(_box_scene(), 0.1))
+    # 0.1 s at 30 Hz = frame 3: frames 0-2 see the floor 3 m below the camera at the image
+    # centre, frames 3-5 the box top, 3 - 1.5 = 1.5 m below it.
+    centre = [float(f.images[0].depth[12, 16]) for f in frames]
+    assert centre == pytest.approx([3.0, 3.0, 3.0, 1.5, 1.5, 1.5], abs=1e-3)
+    with pytest.raises(ValueError, match="no obstacle"):
+        next(left_object_frames(_box_scene().model_copy(update={"obstacles": []}), 0.1))

@@ -49,8 +49,8 @@ ANGLES_DEG = [float(a) for a in range(0, 91, 10)]
 #: straight down (6 m high) sees it from 1 m above the floor.
 ARC_TARGET = (0.0, 0.0, 1.0)
 ARC_DISTANCE_M = 5.0
-#: Seconds of scene 1 per angle (600 frames, 1 x 512x424 depth, streamed).
-SCENE1_S = 20.0
+#: Seconds of scene 1 per angle (300 frames, 1 x 512x424 depth, streamed; 10 angles).
+SCENE1_S = 10.0
 #: Fig. 10: added noise from 0 to beyond 50 mm (the seed went to 125 mm and beyond).
 NOISE_LEVELS_M = [0.0, 0.025, 0.05, 0.075, 0.1, 0.125, 0.15]
 #: Fig. 10, beside the default: the running average with twice the default margin. Its false
