@@ -11,6 +11,7 @@ from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
 from rgbd_eval.methods.dmtbs import check_claims
 from rgbd_eval.methods.dmtbs_experiments import (
     arc_camera,
+    left_object,
     left_object_frames,
     run_frames,
     with_noise,
@@ -159,3 +160,15 @@ def test_left_object_frames_show_the_object_from_its_time_on() -> None:
     assert centre == pytest.approx([3.0, 3.0, 3.0, 1.5, 1.5, 1.5], abs=1e-3)
     with pytest.raises(ValueError, match="no obstacle"):
         next(left_object_frames(_box_scene().model_copy(update={"obstacles": []}), 0.1))
+
+
+def test_an_object_left_behind_is_tracked_from_its_third_frame() -> None:
+    scene = _box_scene().model_copy(update={"duration_s": 3.0})  # 90 frames
+    det = DmtbsDetectorConfig(roi=(-2, -2, 2, 2))  # background learnt over frames 0-29
+    row = left_object(scene, det, DmtbsTrackerConfig(confirm_hits=3), 2.0, settle_s=0.0)
+    # The box appears at 2.0 s = frame 60; frames 60-89 are counted (30). Its track is
+    # confirmed at its third measured frame, 62: frames 62-89 have it, 28 of 30. No person is
+    # ground truth, so each of those 28 outputs is a false positive.
+    assert (row["object_frames"], row["object_tracked_frames"]) == (30, 28)
+    assert row["object_tracked_share"] == pytest.approx(28 / 30)
+    assert row["fp"] == 28 and row["num_gt"] == 0

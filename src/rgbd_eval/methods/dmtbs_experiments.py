@@ -19,6 +19,7 @@ import numpy as np
 from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.detect.dmtbs import BackgroundMethod, DepthView, DmtbsDetector, DmtbsDetectorConfig
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize
+from rgbd_eval.metrics.selection import is_scored_track
 from rgbd_eval.sim.rig_sensors import StaticDepthConfig
 from rgbd_eval.sim.scenario import Obstacle, Scenario
 from rgbd_eval.sim.tof import TofFrame, TofRig
@@ -252,8 +253,9 @@ def left_object(
     """The known limitation (seed 003, section 6): a large object left behind is tracked.
 
     Runs DMT-BS on every camera of ``scenario``, whose first obstacle is the object, and
-    counts the frames from ``settle_s`` after it is left on in which a track lies within
-    ``threshold_m`` of it (none of them matches a person: the object is not ground truth).
+    counts the frames from ``settle_s`` after it is left on in which a reported track (as
+    scored: confirmed, not lost) lies within ``threshold_m`` of it (none of them matches a
+    person: the object is not ground truth).
     """
     obj: Obstacle = scenario.obstacles[0]
     names = [c.name for c in scenario.rig if isinstance(c, StaticDepthConfig)]
@@ -262,7 +264,11 @@ def left_object(
     first = round((left_at_s + settle_s) * rate) - det.init_frames
     after = run.tracks[max(first, 0) :]
     on = [
-        any(math.hypot(t.x - obj.x, t.y - obj.y) <= threshold_m for t in frame) for frame in after
+        any(
+            is_scored_track(t) and math.hypot(t.x - obj.x, t.y - obj.y) <= threshold_m
+            for t in frame
+        )
+        for frame in after
     ]
     return {
         **run.row(),
