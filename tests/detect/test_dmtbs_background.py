@@ -30,14 +30,31 @@ def test_running_average_rules_pixel_by_pixel() -> None:
     # p0: 2.1 - 1.9 = 0.2 > 0.1 -> foreground; B = 2.1 + (1.9 - 2.1) / 2 = 2.0.
     # p1: infinitely far background -> foreground; seen once (adopted after 2 in a row).
     # p2: invalid -> not foreground, B kept at 3.0.
-    # p3: 1.5 is farther: average 1.25, and 1.5 - 1.25 = 0.25 > 0.1 -> revealed, B = 1.5.
+    # p3: 1.5 is farther: average 1.25, and 1.5 - 1.25 = 0.25 > 0.1, farther once (of 2).
     np.testing.assert_array_equal(fg, [[True, True, False, False]])
-    np.testing.assert_allclose(bg.background, _row(2.0, np.inf, 3.0, 1.5), rtol=1e-6)
+    np.testing.assert_allclose(bg.background, _row(2.0, np.inf, 3.0, 1.25), rtol=1e-6)
     fg = bg.apply(_row(2.0, 2.5, 3.0, 1.5), 0.1)
     # p1 valid for the second frame in a row: still foreground now, then adopted as 2.5.
+    # p3: average 1.25 + (1.5 - 1.25) / 2 = 1.375, 1.5 - 1.375 = 0.125 > 0.1, farther for
+    # the second frame in a row -> revealed, B = 1.5.
     np.testing.assert_array_equal(fg, [[False, True, False, False]])
     np.testing.assert_allclose(bg.background, _row(2.0, 2.5, 3.0, 1.5), rtol=1e-6)
     assert not bg.apply(_row(2.0, 2.5, 3.0, 1.5), 0.1).any()
+
+
+def test_one_far_noise_sample_does_not_move_the_background() -> None:
+    bg = RunningAverageBackground(init_frames=3, time_constant_s=HALF_TAU, margin_m=0.1)
+    for _ in range(3):
+        bg.apply(_row(2.0), 0.1)
+    # One sample 0.3 m too far (noise): average 2.15, farther by 0.15 once (of 3): B = 2.15,
+    # not 2.3 -> the next ordinary sample (2.0) is 0.15 nearer: foreground this once, and
+    # B averages back to 2.075, the one after that is background again (0.075 < 0.1).
+    assert not bg.apply(_row(2.3), 0.1).any()
+    assert bg.background is not None and float(bg.background[0, 0]) == pytest.approx(2.15)
+    assert bg.apply(_row(2.0), 0.1).all()
+    assert not bg.apply(_row(2.0), 0.1).any()
+    # Had B jumped to 2.3 (adopting single far samples), 2.0 would have been foreground for
+    # two frames (2.3 -> 2.15 -> 2.075), and every far sample would start that again.
 
 
 def test_weight_follows_the_time_step() -> None:
@@ -115,3 +132,46 @@ def test_mog2_does_not_flag_a_revealed_farther_surface() -> None:
     fg = bg.apply(z, 1 / 30)
     assert not fg[10:20, 10:20].any()
     assert fg[25:35, 25:35].all()
+
+
+def test_mog2_finds_an_object_in_front_of_pixels_that_never_return() -> None:
+    # The top rows never return (the void above a floor's far edge); an object appears there.
+    # They must count as infinitely far: had they entered as 0 m, the object (2 m) would lie
+    # farther than that background and never be foreground.
+    rng = np.random.default_rng(7)
+    bg = Mog2Background(10, 3.0, 16.0, 0.05**2, 0.01**2, 0.2**2)
+    for _ in range(20):
+        z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+        z[:10] = np.nan
+        assert not bg.apply(z, 1 / 30).any()
+    z = (3.0 + 0.01 * rng.standard_normal((40, 40))).astype(np.float32)
+    z[:10] = np.nan
+    z[2:8, 15:25] = 2.0
+    fg = bg.apply(z, 1 / 30)
+    assert fg[2:8, 15:25].all()
+    fg[2:8, 15:25] = False
+    assert not fg.any()
+
+
+def test_mog2_keeps_the_background_of_pixels_with_dropouts() -> None:
+    # Two frames in three the left half drops out (flying pixels, dark material). The dropouts
+    # must not take one of MOG2's two modes: when an object passes (frames 40-49) and leaves,
+    # the wall (3 m) must still be the background, not foreground.
+    rng = np.random.default_rng(11)
+    bg = Mog2Background(10, 3.0, 16.0, 0.05**2, 0.01**2, 0.2**2)
+
+    def wall(k: int) -> np.ndarray:
+        z = (3.0 + 0.005 * rng.standard_normal((20, 20))).astype(np.float32)
+        if k % 3 != 0:
+            z[:, :10] = np.nan
+        return z
+
+    for k in range(40):
+        bg.apply(wall(k), 1 / 30)
+    for k in range(40, 50):
+        z = wall(k)
+        z[5:15, 5:15] = 1.8 + 0.02 * (k - 40)  # an object walking through, 1.8-2.0 m
+        bg.apply(z, 1 / 30)
+    for k in range(50, 60):
+        fg = bg.apply(wall(k), 1 / 30)
+        assert not fg.any()

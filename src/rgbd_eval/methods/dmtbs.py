@@ -31,28 +31,61 @@ register_method(
 )
 
 
+#: Scene 1 (seed 003 4.3.1): one camera moved along an arc (Fig. 8).
+SCENE1 = "dmtbs/scene1.yaml"
 #: Scene 2 (seed 003 4.3.2), rendered in memory for the sensitivity analyses.
 SCENE2 = "dmtbs/scene2.yaml"
+#: The left-behind object (seed 003 section 6); the box appears at LEFT_OBJECT_AT_S.
+LEFT_OBJECT = "dmtbs/left_object.yaml"
+LEFT_OBJECT_AT_S = 5.0
 #: Seconds of scene 2 used: the seed ran seven sequences of 100 s (4.3.2); one sequence of
 #: 15 s (450 frames, 4 x 512x424 depth, ~1.6 GB in memory) keeps `reproduce` to minutes.
 REPRODUCE_S = 15.0
+#: Fig. 8: "10 different camera angles" from horizontal to looking down (4.3.1; the range's
+#: end did not survive in the text): 0 to 90 degrees in steps of 10.
+ANGLES_DEG = [float(a) for a in range(0, 91, 10)]
+#: Fig. 8's arc: around the point 1 m above the floor's centre (the height threshold, 3.2),
+#: at 5 m, so that a level camera sees the whole 5 m x 5 m floor and a camera looking
+#: straight down (6 m high) sees it from 1 m above the floor.
+ARC_TARGET = (0.0, 0.0, 1.0)
+ARC_DISTANCE_M = 5.0
+#: Seconds of scene 1 per angle (300 frames, 1 x 512x424 depth, streamed; 10 angles).
+SCENE1_S = 10.0
 #: Fig. 10: added noise from 0 to beyond 50 mm (the seed went to 125 mm and beyond).
 NOISE_LEVELS_M = [0.0, 0.025, 0.05, 0.075, 0.1, 0.125, 0.15]
+#: Fig. 10, beside the default: the running average with twice the default margin. Its false
+#: foreground rate on static surfaces is Phi(-margin / sigma), so the noise it collapses at
+#: scales with the margin; the seed's margin was lost. A diagnostic, not a tuned value: the
+#: claims are checked on the default's rows.
+WIDE_MARGIN_M = 0.2
 #: Fig. 11: yaw error of the second camera, 0 to 3 degrees.
 YAW_ERRORS_DEG = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0]
 
 
 def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
     from rgbd_eval.config import config_dir, load_config
-    from rgbd_eval.dmtbs_simrun import calibration_error, camera_count, depth_noise
+    from rgbd_eval.methods.dmtbs_experiments import (
+        calibration_error,
+        camera_angle,
+        camera_count,
+        depth_noise,
+        left_object,
+    )
     from rgbd_eval.sim.scenario import load_scenario
     from rgbd_eval.sim.tof import TofRig
 
-    scenario = load_scenario(config_dir() / "scenarios" / SCENE2, [("duration_s", REPRODUCE_S)])
+    scenes = config_dir() / "scenarios"
+    scenario = load_scenario(scenes / SCENE2, [("duration_s", REPRODUCE_S)])
     config = load_config(method="dmtbs", overrides=["detector.roi=[-2.5,-2.5,2.5,2.5]"])
     det, trk = config.detector, config.tracker
     if not isinstance(det, DmtbsDetectorConfig) or not isinstance(trk, DmtbsTrackerConfig):
         raise TypeError("the dmtbs method config must select the dmtbs detector and tracker")
+    scene1 = load_scenario(scenes / SCENE1, [("duration_s", SCENE1_S)])
+    angles = camera_angle(
+        scene1, det, trk, ANGLES_DEG, ARC_TARGET, ARC_DISTANCE_M, options.progress
+    )
+    options.progress("section 6: an object left behind")
+    left = left_object(load_scenario(scenes / LEFT_OBJECT), det, trk, LEFT_OBJECT_AT_S)
     rig = TofRig(scenario)
     options.progress(f"rendering {rig.n_frames} frames of scene 2, {len(rig.names)} cameras")
     frames = list(rig.frames())
@@ -61,10 +94,26 @@ def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> Rep
     cams = camera_count(frames, names, det, trk)
     options.progress("Fig. 10: depth noise, running average and MOG2 (two cameras)")
     noise = depth_noise(frames, names[:2], det, trk, NOISE_LEVELS_M, scenario.seed)
+    options.progress(f"Fig. 10: the running average with a {WIDE_MARGIN_M:g} m margin")
+    wide = det.model_copy(update={"foreground_margin_m": WIDE_MARGIN_M})
+    noise_wide = [
+        {**r, "background": f"running_average (margin {WIDE_MARGIN_M:g} m)"}
+        for r in depth_noise(
+            frames, names[:2], wide, trk, NOISE_LEVELS_M, scenario.seed, mog2=False
+        )
+    ]
     options.progress("Fig. 11: yaw error of the second camera (two cameras)")
     yaw = calibration_error(frames, names[:2], det, trk, YAW_ERRORS_DEG)
-    claims = check_claims(cams, noise, yaw)
-    data = {"frames": len(frames), "cameras": cams, "noise": noise, "yaw": yaw}
+    claims = check_claims(cams, noise, yaw, angles, left)
+    data = {
+        "frames": len(frames),
+        "angles": angles,
+        "cameras": cams,
+        "noise": noise,
+        "noise_wide_margin": noise_wide,
+        "yaw": yaw,
+        "left_object": left,
+    }
     return ReproduceResult(render_markdown(data, claims), data, tuple(claims))
 
 
@@ -82,13 +131,29 @@ def _mota(rows: list[dict[str, Any]], **match: Any) -> float:
 
 
 def check_claims(
-    cams: list[dict[str, Any]], noise: list[dict[str, Any]], yaw: list[dict[str, Any]]
+    cams: list[dict[str, Any]],
+    noise: list[dict[str, Any]],
+    yaw: list[dict[str, Any]],
+    angles: list[dict[str, Any]],
+    left: Mapping[str, Any],
 ) -> list[tuple[str, bool]]:
-    """The seed's claims (section 5.2), each tested on the measured rows."""
+    """The seed's claims (sections 5.2 and 6), each tested on the measured rows."""
     m = {r["cameras"]: _value(r) for r in cams}
     ra = "running_average"
     top = max(r["noise_m"] for r in noise)
+    by_angle = {float(r["angle_deg"]): _value(r) for r in angles}
+    shallow = [v for a, v in by_angle.items() if a <= 30.0]
+    steep = [v for a, v in by_angle.items() if a > 30.0]
+    share = left["object_tracked_share"]
     return [
+        (
+            "Fig. 8: performs well at every angle (MOTA >= 80% at each of the 10 angles)",
+            all(v >= 0.80 for v in by_angle.values()),
+        ),
+        (
+            "Fig. 8: lower at shallow angles (mean MOTA at 0-30 deg below the mean at 40-90 deg)",
+            bool(shallow and steep) and sum(shallow) / len(shallow) < sum(steep) / len(steep),
+        ),
         (
             "Fig. 9: MOTA rises strongly from one to two cameras (>= 5 points) and only "
             "slightly beyond (<= 2 points from two to four)",
@@ -118,6 +183,11 @@ def check_claims(
             "Fig. 11: a yaw error of 1 degree of the second camera costs at most 2 points of MOTA",
             _mota(yaw, yaw_error_deg=1.0) >= _mota(yaw, yaw_error_deg=0.0) - 0.02,
         ),
+        (
+            "6: a large object left behind is tracked as a static person (a track lies on it "
+            "in >= 90% of the frames from 1 s after it is left)",
+            share is not None and float(share) >= 0.90,
+        ),
     ]
 
 
@@ -139,14 +209,22 @@ def _table(rows: list[dict[str, Any]], first: list[str]) -> list[str]:
 
 
 def render_markdown(data: Mapping[str, Any], claims: list[tuple[str, bool]]) -> str:
+    left = data["left_object"]
     lines = [
-        "# Reproduction of dmtbs (seed 003, 4.3) on scene 2, in memory",
+        "# Reproduction of dmtbs (seed 003, 4.3 and 6) on scenes 1 and 2, in memory",
         "",
         f"One sequence of scene 2 ({data['frames']} frames at 30 Hz; the seed used seven of "
         "100 s), four static ToF cameras (configs/scenarios/dmtbs/scene2.yaml). Metric gating "
         "at 0.5 m; the first second (background initialisation) is not scored. The seed's "
-        "figures lost their numbers: only its claims are checked. Scene 1 (camera angle, "
-        "Fig. 8) is not reproduced.",
+        "figures lost their numbers: only its claims are checked.",
+        "",
+        "## Fig. 8: camera angle (scene 1, one camera)",
+        "",
+        f"Scene 1 (configs/scenarios/dmtbs/scene1.yaml, {SCENE1_S:g} s): three people crossing "
+        f"on the camera's line of sight; the camera {ARC_DISTANCE_M:g} m from the point "
+        f"{ARC_TARGET[2]:g} m above the floor's centre, from level (0 deg) to straight down.",
+        "",
+        *_table(list(data["angles"]), ["angle_deg", "camera_height_m"]),
         "",
         "## Fig. 9: number of cameras",
         "",
@@ -156,9 +234,24 @@ def render_markdown(data: Mapping[str, Any], claims: list[tuple[str, bool]]) -> 
         "",
         *_table(list(data["noise"]), ["background", "noise_m"]),
         "",
+        f"The running average with a {WIDE_MARGIN_M:g} m foreground margin (the default is "
+        "0.1 m; a diagnostic, the claims use the default): its false foreground rate on "
+        "static surfaces is Phi(-margin / noise), so where it collapses scales with the margin.",
+        "",
+        *_table(list(data["noise_wide_margin"]), ["background", "noise_m"]),
+        "",
         "## Fig. 11: yaw error of the second camera (two cameras)",
         "",
         *_table(list(data["yaw"]), ["yaw_error_deg"]),
+        "",
+        "## Section 6: an object left behind (two cameras)",
+        "",
+        f"configs/scenarios/dmtbs/left_object.yaml: a 1.5 m box is set down at "
+        f"{LEFT_OBJECT_AT_S:g} s and stays; it is not ground truth. A track lies within 0.5 m "
+        f"of it in {left['object_tracked_frames']} of the {left['object_frames']} frames from "
+        "1 s after it is left.",
+        "",
+        *_table([dict(left)], []),
         "",
         "## Claims",
         "",
@@ -171,7 +264,8 @@ def render_markdown(data: Mapping[str, Any], claims: list[tuple[str, bool]]) -> 
 register_paper(
     PaperSpec(
         method="dmtbs",
-        title="seed 003 4.3: Figs. 9-11 (cameras, depth noise, calibration error) on scene 2",
+        title="seed 003 4.3: Figs. 8-11 (camera angle on scene 1; cameras, depth noise, "
+        "calibration error on scene 2) and the left-behind object",
         scenarios=(),
         run=_reproduce,
     )
