@@ -1,8 +1,9 @@
 """Content-addressed on-disk cache of detections, safe to share between processes and machines.
 
 Detections are a pure function of (recording, io config, detector config: its
-``name`` included, and the contents of the files it names, such as a model), so a sweep over tracker parameters runs detection once per
-sequence. The key is the sha256 of exactly those inputs (:func:`detection_key`).
+``name`` included, and the contents of the files it names, such as a model), so
+a sweep over tracker parameters runs detection once per sequence. The key is the
+sha256 of exactly those inputs (:func:`detection_key`).
 
 An entry is one file, ``detections/<key[:2]>/<key>.det``: a magic line, the
 sha256 of the payload in hex, a newline, then the payload, an uncompressed
