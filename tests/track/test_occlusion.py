@@ -18,9 +18,14 @@ from rgbd_eval.track.occlusion import (
     OcclusionClassifier,
     OcclusionScene,
     depth_order,
+    in_front,
     load_classifiers,
+    merge_sort_by,
     order,
+    overlap,
     pair_features,
+    scene_for,
+    shipped_classifier,
     sort_front_to_back,
 )
 
@@ -96,12 +101,12 @@ def test_order_on_hand_made_pairs() -> None:
     thermal = _one_stump("edge_thermal")
     # margin H(f) - H(-f) = 1 - (-1) = 2 > 0: a in front; never both ways
     for clf in (colour, thermal):
-        assert order(A, B, scene, clf)
-        assert not order(B, A, scene, clf)
+        assert in_front(A, B, scene, clf)
+        assert not in_front(B, A, scene, clf)
     # the same boxes with the painting order swapped: now b shows in the overlap
     swapped = _paint([(50, 30, 74, 90), (40, 20, 60, 80)], [32.0, 28.0], [BLUE, RED])
-    assert order(B, A, swapped, colour)
-    assert not order(A, B, swapped, colour)
+    assert in_front(B, A, swapped, colour)
+    assert not in_front(A, B, swapped, colour)
 
 
 def test_without_colour_the_colour_votes_cancel() -> None:
@@ -109,8 +114,8 @@ def test_without_colour_the_colour_votes_cancel() -> None:
     scene = OcclusionScene.of(t)  # no colour image: colour features are 0
     clf = _one_stump("overlap_colour_mean")
     # margin H(0) - H(-0) = 0: the tie goes to the lower bottom (a: 90 > b: 80), both ways
-    assert order(A, B, scene, clf)
-    assert not order(B, A, scene, clf)
+    assert in_front(A, B, scene, clf)
+    assert not in_front(B, A, scene, clf)
 
 
 def test_sort_is_m_log_m_and_correct() -> None:
@@ -124,7 +129,7 @@ def test_sort_is_m_log_m_and_correct() -> None:
             calls += 1
             return bool(depth[i] < depth[j])
 
-        assert sort_front_to_back(m, in_front) == list(np.argsort(depth))
+        assert merge_sort_by(m, in_front) == list(np.argsort(depth))
         # merge sort: at most m * ceil(log2 m) comparisons (seed 004: M_O log M_O)
         assert calls <= m * math.ceil(math.log2(m)) if m > 1 else calls == 0
 
@@ -163,3 +168,34 @@ def test_bad_input_is_refused(tmp_path: Path) -> None:
         load_classifiers(bad)
     with pytest.raises(ConfigError, match="cannot read"):
         load_classifiers(tmp_path / "missing.json")
+
+
+def test_tracker_interface() -> None:
+    # order(a, b, thermal, colour) -> 0 when a is in front, 1 when b is (track/cielniak2010.py)
+    thermal = np.full((100, 100), 20.0)
+    thermal[20:80, 40:60] = 28.0
+    thermal[30:90, 50:74] = 32.0
+    colour = np.full((100, 100, 3), 100, dtype=np.uint8)
+    colour[20:80, 40:60] = RED
+    colour[30:90, 50:74] = BLUE
+    clf = _one_stump("overlap_colour_mean")
+    a, b = np.array(A), np.array(B)
+    assert order(a, b, thermal, colour, classifier=clf) == 0
+    assert order(b, a, thermal, colour, classifier=clf) == 1
+    assert sort_front_to_back([b, a], thermal, colour, classifier=clf) == [1, 0]
+    # the scene is built once per frame: same image objects, same scene
+    assert scene_for(thermal, colour) is scene_for(thermal, colour)
+    assert scene_for(thermal.copy(), colour) is not scene_for(thermal, colour)
+    # intersection 10 x 50 = 500 over the smaller box, b: 20 x 60 = 1200
+    assert overlap(a, b) == pytest.approx(500 / 1200)
+    assert overlap(a, (0.0, 0.0, 10.0, 10.0)) == 0.0
+
+
+def test_shipped_classifier_puts_lower_feet_in_front_on_a_blank_image() -> None:
+    # no appearance (a uniform image): only the geometry speaks; the near person's box is
+    # taller and its feet lower (v = 200 against 150)
+    near = np.array([100.0, 40.0, 140.0, 200.0])
+    far = np.array([120.0, 60.0, 150.0, 150.0])
+    thermal = np.zeros((240, 320))
+    assert order(near, far, thermal) == 0 and order(far, near, thermal) == 1
+    assert in_front(tuple(near), tuple(far), scene_for(thermal), shipped_classifier("thermal"))

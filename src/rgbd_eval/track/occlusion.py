@@ -26,10 +26,14 @@ colour group (the colour image, aligned by the thermal-to-colour affine map, sec
   ``edge_colour``: as ``edge_thermal`` on the colour image's luminance.
 
 Every feature is antisymmetric, ``f(b, a) = -f(a, b)``, and the decision is
-``H(f(a, b)) - H(f(b, a)) > 0`` with ``H`` the boosted score, so ``order(a, b)`` and
-``order(b, a)`` never both hold (a tie falls back to the lower box bottom). A feature that
+``H(f(a, b)) - H(f(b, a)) > 0`` with ``H`` the boosted score, so ``in_front(a, b)`` and
+``in_front(b, a)`` never both hold (a tie falls back to the lower box bottom). A feature that
 cannot be measured (no colour image, ``a`` wholly inside ``b``) is 0, which adds the same
 vote to both scores and so drops out.
+
+The tracker's interface (``track/cielniak2010.py``): ``order(a, b, thermal, colour,
+affine) -> 0 | 1`` (0: ``a`` is in front), ``sort_front_to_back(boxes, thermal, colour,
+affine)`` and ``overlap(a, b)``; they build the :class:`OcclusionScene` once per frame.
 """
 
 from __future__ import annotations
@@ -301,7 +305,7 @@ def shipped_classifier(group: str = "both") -> OcclusionClassifier:
     return models[group]
 
 
-def order(
+def in_front(
     a: Box, b: Box, scene: OcclusionScene, classifier: OcclusionClassifier | None = None
 ) -> bool:
     """True when person ``a`` is in front of person ``b`` (boxes on the thermal image).
@@ -317,12 +321,13 @@ def order(
     return (a[3], a[2] - a[0], a[0]) > (b[3], b[2] - b[0], b[0])
 
 
-def sort_front_to_back(count: int, in_front: Callable[[int, int], bool]) -> list[int]:
+def merge_sort_by(count: int, a_in_front: Callable[[int, int], bool]) -> list[int]:
     """Indices ``0 .. count-1`` sorted front to back by a pairwise test (merge sort).
 
-    At most ``count * ceil(log2 count)`` calls of ``in_front`` (seed 004, section 5:
-    "M_O log(M_O) comparisons"); stable: when ``in_front(i, j)`` is False for an earlier
-    ``i``, ``j`` goes first. The test need not be transitive; any answer is a permutation.
+    At most ``count * ceil(log2 count)`` calls of ``a_in_front`` (seed 004, section 5:
+    "M_O log(M_O) comparisons"); stable: when ``a_in_front(j, i)`` is False for a later
+    ``j``, the earlier ``i`` goes first. The test need not be transitive; any answer is a
+    permutation.
     """
     if count < 0:
         raise ValueError(f"count={count} must be non-negative")
@@ -335,7 +340,7 @@ def sort_front_to_back(count: int, in_front: Callable[[int, int], bool]) -> list
         out: list[int] = []
         i = j = 0
         while i < len(left) and j < len(right):
-            if in_front(right[j], left[i]):
+            if a_in_front(right[j], left[i]):
                 out.append(right[j])
                 j += 1
             else:
@@ -346,21 +351,97 @@ def sort_front_to_back(count: int, in_front: Callable[[int, int], bool]) -> list
     return merge_sort(list(range(count)))
 
 
+def _as_box(box: Sequence[float] | NDArray[np.floating[Any]]) -> Box:
+    values = [float(x) for x in box]
+    if len(values) != 4:
+        raise ValueError(f"box {values} must have 4 coordinates (u0, v0, u1, v1)")
+    return (values[0], values[1], values[2], values[3])
+
+
 def depth_order(
-    persons: Sequence[Box], scene: OcclusionScene, classifier: OcclusionClassifier | None = None
+    persons: Sequence[Sequence[float] | NDArray[np.floating[Any]]],
+    scene: OcclusionScene,
+    classifier: OcclusionClassifier | None = None,
 ) -> list[int]:
-    """Indices of ``persons`` (thermal boxes) from front to back, by :func:`order`."""
-    boxes = [tuple(float(x) for x in p) for p in persons]
-    for box in boxes:
-        if len(box) != 4:
-            raise ValueError(f"box {box} must have 4 coordinates")
+    """Indices of ``persons`` (thermal boxes) from front to back, by :func:`in_front`."""
+    boxes = [_as_box(p) for p in persons]
     clf = classifier if classifier is not None else shipped_classifier()
+    return merge_sort_by(len(boxes), lambda i, j: in_front(boxes[i], boxes[j], scene, clf))
 
-    def in_front(i: int, j: int) -> bool:
-        bi, bj = boxes[i], boxes[j]
-        return order((bi[0], bi[1], bi[2], bi[3]), (bj[0], bj[1], bj[2], bj[3]), scene, clf)
 
-    return sort_front_to_back(len(boxes), in_front)
+# ----------------------------------------------------------------------------- tracker interface
+# The interface agreed with the tracker (track/cielniak2010.py): images in, the scene built
+# once per frame (the last one is kept while the tracker passes the same image objects).
+
+_last: list[tuple[object, object, object, OcclusionScene]] = []
+
+
+def scene_for(
+    thermal: NDArray[np.floating[Any]],
+    colour: NDArray[np.uint8] | None = None,
+    affine: AffineLike | None = None,
+) -> OcclusionScene:
+    """:meth:`OcclusionScene.of`, reused while the same image objects are passed.
+
+    Without ``affine`` the colour image is mapped by the ratio of the image sizes (parallel
+    cameras with equal fields of view and no parallax); pass the tracker's affine map.
+    """
+    if _last and _last[0][0] is thermal and _last[0][1] is colour and _last[0][2] is affine:
+        return _last[0][3]
+    mapping = affine
+    if mapping is None and colour is not None:
+        t, c = np.shape(thermal), np.shape(colour)
+        mapping = _SizeRatio((c[1] / t[1], c[0] / t[0]), (0.0, 0.0))
+    scene = OcclusionScene.of(thermal, colour, mapping)
+    _last[:] = [(thermal, colour, affine, scene)]  # holds the images: their ids stay unique
+    return scene
+
+
+@dataclass(frozen=True)
+class _SizeRatio:
+    scale: tuple[float, float]
+    offset: tuple[float, float]
+
+
+def order(
+    a: Sequence[float] | NDArray[np.floating[Any]],
+    b: Sequence[float] | NDArray[np.floating[Any]],
+    thermal: NDArray[np.floating[Any]],
+    colour: NDArray[np.uint8] | None = None,
+    affine: AffineLike | None = None,
+    classifier: OcclusionClassifier | None = None,
+) -> int:
+    """Which of two persons is in front: 0 for ``a``, 1 for ``b``.
+
+    ``a``, ``b``: boxes ``(u0, v0, u1, v1)`` on the thermal image; ``thermal``: its
+    temperatures; ``colour``: the colour image, mapped to the thermal one by ``affine``
+    (``colour = scale * thermal + offset``).
+    """
+    scene = scene_for(thermal, colour, affine)
+    return 0 if in_front(_as_box(a), _as_box(b), scene, classifier) else 1
+
+
+def sort_front_to_back(
+    boxes: Sequence[Sequence[float] | NDArray[np.floating[Any]]],
+    thermal: NDArray[np.floating[Any]],
+    colour: NDArray[np.uint8] | None = None,
+    affine: AffineLike | None = None,
+    classifier: OcclusionClassifier | None = None,
+) -> list[int]:
+    """Indices of ``boxes`` from front to back (seed 004, section 5: M log M comparisons)."""
+    return depth_order(boxes, scene_for(thermal, colour, affine), classifier)
+
+
+def overlap(
+    a: Sequence[float] | NDArray[np.floating[Any]], b: Sequence[float] | NDArray[np.floating[Any]]
+) -> float:
+    """Intersection over the smaller box (0 when they do not overlap)."""
+    ba, bb = _as_box(a), _as_box(b)
+    o = intersection(ba, bb)
+    if o is None:
+        return 0.0
+    smaller = min((ba[2] - ba[0]) * (ba[3] - ba[1]), (bb[2] - bb[0]) * (bb[3] - bb[1]))
+    return (o[2] - o[0]) * (o[3] - o[1]) / max(smaller, 1e-9)
 
 
 def classifier_summary(models: Mapping[str, OcclusionClassifier]) -> dict[str, list[str]]:
