@@ -4,8 +4,14 @@ from __future__ import annotations
 
 from typing import Any
 
+from rgbd_eval.config import load_config
 from rgbd_eval.io.groundtruth import from_objects
-from rgbd_eval.methods.cielniak2010_experiments import check_claims, occluded_share, paper_values
+from rgbd_eval.methods.cielniak2010_experiments import (
+    check_claims,
+    occluded_share,
+    paper_values,
+    plan_variants,
+)
 from rgbd_eval.types import Box2D, GroundTruthObject
 
 
@@ -98,3 +104,16 @@ def test_claims_without_a_variant_are_not_judged() -> None:
     assert claims["colour_fewer_switches"].held is None
     assert claims["occlusion_recovers_identities"].held is None
     assert claims["thermal_in_darkness"].held is None
+
+
+def test_a_missing_switch_counts_as_off() -> None:
+    base = load_config(method="cielniak2010").model_dump(mode="json")
+    variants = {
+        "off": {"tracker.no_such_switch": False, "tracker.seed": 1},
+        "on": {"tracker.no_such_switch": True},
+        "known": {"tracker.seed": 2},
+    }
+    runnable, skipped = plan_variants(base, variants)
+    assert runnable == {"off": {"tracker.seed": 1}, "known": {"tracker.seed": 2}}
+    assert set(skipped) == {"on"}
+    assert "no_such_switch" in skipped["on"]

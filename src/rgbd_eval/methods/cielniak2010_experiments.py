@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from rgbd_eval.config import build_config, config_dir, load_config, load_yaml
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.errors import ConfigError, TaskError
 from rgbd_eval.io.groundtruth import GroundTruth
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
@@ -87,6 +87,32 @@ def _stats(values: Sequence[float | None]) -> dict[str, float | None]:
     return {"mean": statistics.fmean(v), "min": min(v), "max": max(v)}
 
 
+def plan_variants(
+    base: Mapping[str, Any], variants: Mapping[str, Mapping[str, Any]]
+) -> tuple[dict[str, dict[str, Any]], dict[str, str]]:
+    """The overrides of the variants that can run, and why the others cannot.
+
+    A switch the tracker config does not have counts as off: set to false it is dropped,
+    set to anything else its variant is not run.
+    """
+    runnable: dict[str, dict[str, Any]] = {}
+    skipped: dict[str, str] = {}
+    for name, overrides in variants.items():
+        kept: dict[str, Any] = {}
+        for key, value in overrides.items():
+            try:
+                build_config(base, [(key, value)], source=f"ablation {name}")
+            except ConfigError as err:
+                if value is False:
+                    continue
+                skipped[name] = str(err)
+                break
+            kept[key] = value
+        else:
+            runnable[name] = kept
+    return runnable, skipped
+
+
 def ablation(
     recordings: Mapping[str, Path],
     variants: Mapping[str, Mapping[str, Any]],
@@ -95,29 +121,22 @@ def ablation(
 ) -> tuple[dict[str, dict[int, dict[str, Counts]]], dict[str, str]]:
     """Counts per variant, seed and scenario; and the variants that cannot run, with why."""
     base = load_config(method="cielniak2010").model_dump(mode="json")
-    points: list[dict[str, Any]] = []
-    labels: list[tuple[str, int]] = []
-    skipped: dict[str, str] = {}
-    for name, overrides in variants.items():
-        try:
-            build_config(base, list(overrides.items()), source=f"ablation {name}")
-        except ConfigError as err:
-            skipped[name] = str(err)
-            continue
-        for seed in seeds:
-            points.append({**overrides, "tracker.seed": seed})
-            labels.append((name, seed))
+    runnable, skipped = plan_variants(base, variants)
+    points = [{**kept, "tracker.seed": s} for kept in runnable.values() for s in seeds]
+    labels = [(name, s) for name in runnable for s in seeds]
     out: dict[str, dict[int, dict[str, Counts]]] = {}
     if not points:
         return out, skipped
     configs = point_configs(base, [], points)
     result = run_sweep(list(recordings.values()), points, configs, options.client, options.cache)
+    if result.failures:
+        first = result.failures[0]
+        label = ", ".join(f"{k}={v}" for k, v in first.point.items())
+        raise TaskError(f"ablation {label} on {first.sequence}: {first.error}", first.exit_code)
     names = {sequence_name(p): n for n, p in recordings.items()}
     for r in result.records:
         name, seed = labels[points.index(r.point)]
         out.setdefault(name, {}).setdefault(seed, {})[names[r.sequence]] = r.counts
-    for f in result.failures:
-        raise ConfigError(f"ablation failed: {f}")
     return out, skipped
 
 
