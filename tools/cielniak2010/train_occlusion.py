@@ -7,8 +7,9 @@ Renders ``--train-pairs`` overlapping pairs for the training seed and ``--test-p
 the held-out seed (:mod:`rgbd_eval.sim.occlusion_pairs`), trains one discrete AdaBoost per
 feature group (thermal, colour, both; :mod:`rgbd_eval.track.occlusion_training`), prints
 the held-out accuracy per group and writes the stumps with their provenance to
-``src/rgbd_eval/data/cielniak2010_occlusion.json`` (atomically). Same arguments, same file,
-byte for byte. About 0.3 s of CPU per rendered pair.
+``src/rgbd_eval/data/cielniak2010_occlusion.json`` (atomically). Same arguments, same file
+(on one machine and library versions: the features go through numpy's floating point).
+About 0.3 s of CPU per rendered pair.
 """
 
 from __future__ import annotations
