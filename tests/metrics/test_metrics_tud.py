@@ -10,13 +10,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 import pytest
+from trackeval_parity import assert_counts_equal_trackeval, trackeval_data
 
 from rgbd_eval.config import Convention, EvaluationConfig, Gating
 from rgbd_eval.io.tracks import align, read_mot_gt, read_mot_tracks
 from rgbd_eval.metrics import Counts, evaluate_sequence, summarize, total
-from rgbd_eval.metrics.gating import iou_matrix
 
 mm = pytest.importorskip("motmetrics")
 DATA = Path(mm.__file__).parent / "data"
@@ -117,50 +116,9 @@ def test_tud_equals_motmetrics_expected_values(name: str) -> None:
 
 @pytest.mark.parametrize("name", ["TUD-Campus", "TUD-Stadtmitte"])
 def test_tud_equals_trackeval(name: str) -> None:
-    te = pytest.importorskip("trackeval.metrics")
+    pytest.importorskip("trackeval.metrics")
     gt = read_mot_gt(DATA / name / "gt.txt")
     tracks = read_mot_tracks(DATA / name / "test.txt")
     aligned = align(gt, tracks, max_gap_ns=0)
-    gt_map: dict[int, int] = {}
-    tr_map: dict[int, int] = {}
-    gt_ids, tr_ids, sims = [], [], []
-    for fg, ft in zip(aligned.gt, aligned.tracks, strict=True):
-        gt_ids.append(
-            np.array([gt_map.setdefault(g.object_id, len(gt_map)) for g in fg], dtype=int)
-        )
-        tr_ids.append(np.array([tr_map.setdefault(t.track_id, len(tr_map)) for t in ft], dtype=int))
-        a = np.array([g.box2d.as_tuple() for g in fg if g.box2d]).reshape(-1, 4)
-        b = np.array([t.box2d.as_tuple() for t in ft if t.box2d]).reshape(-1, 4)
-        sims.append(iou_matrix(a, b))
-    data = {
-        "num_timesteps": len(aligned.gt),
-        "num_gt_ids": len(gt_map),
-        "num_tracker_ids": len(tr_map),
-        "num_gt_dets": sum(map(len, aligned.gt)),
-        "num_tracker_dets": sum(map(len, aligned.tracks)),
-        "gt_ids": gt_ids,
-        "tracker_ids": tr_ids,
-        "similarity_scores": sims,
-    }
-    clear = te.CLEAR({"PRINT_CONFIG": False}).eval_sequence(data)
-    ident = te.Identity({"PRINT_CONFIG": False}).eval_sequence(data)
-    hota = te.HOTA().eval_sequence(data)
     c = _score(name, Convention.MOTCHALLENGE)
-    assert (c.num_matches, c.fp, c.fn, c.id_switches) == (
-        clear["CLR_TP"],
-        clear["CLR_FP"],
-        clear["CLR_FN"],
-        clear["IDSW"],
-    )
-    assert (c.mostly_tracked, c.partly_tracked, c.mostly_lost, c.fragmentations) == (
-        clear["MT"],
-        clear["PT"],
-        clear["ML"],
-        clear["Frag"],
-    )
-    assert c.idtp == ident["IDTP"]
-    assert c.similarity_sum == pytest.approx(clear["MOTP_sum"], abs=1e-9)
-    s = c.hota.summary()
-    assert s["hota"] == pytest.approx(float(np.mean(hota["HOTA"])), abs=1e-12)
-    assert s["assa"] == pytest.approx(float(np.mean(hota["AssA"])), abs=1e-12)
-    assert s["loca"] == pytest.approx(float(np.mean(hota["LocA"])), abs=1e-12)
+    assert_counts_equal_trackeval(c, trackeval_data(aligned.gt, aligned.tracks, Gating.IOU))
