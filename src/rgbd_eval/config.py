@@ -376,6 +376,8 @@ def build_config(
         by = next(
             (f"--set {k}={v}" for k, v in overridden if loc == k or loc.startswith(f"{k}.")), None
         )
+        if by is None and not loc and overridden:  # a cross-section check: name the overrides
+            by = f"{source} with " + " ".join(f"--set {k}={v}" for k, v in overridden)
         blamed.append(f"{by or source}: {loc or '<root>'}: {msg}")
     raise ConfigError("; ".join(blamed))
 

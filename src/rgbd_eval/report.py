@@ -160,6 +160,7 @@ def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
         "world_frame": info.world_frame,
         "sync": asdict(info.sync),
         "warnings": list(info.warnings),
+        "skipped_messages": [asdict(s) for s in info.skipped],  # damaged, per topic
         "ground_truth": None
         if gt is None
         else {

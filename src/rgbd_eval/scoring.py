@@ -143,13 +143,15 @@ def table_rows(sequences: Sequence[ScoredSequence], gating: Gating) -> list[list
 
 
 def write_report(
-    out_dir: Path,
+    folder: OutputFolder,
     sequences: Sequence[ScoredSequence],
     config: EvaluationConfig,
     max_gap_ns: int,
     also: Callable[[Path, dict[str, Any]], None] | None = None,
 ) -> dict[str, Any]:
-    """Write report.json, report.md and one events.csv per sequence, atomically as a folder.
+    """Write report.json, report.md and one events.csv per sequence into ``folder``'s
+    staging folder (prepared before the inputs were read, as ``run`` does), then publish it;
+    the caller's ``with folder`` discards the staging folder when this fails.
 
     ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder.
     """
@@ -170,18 +172,17 @@ def write_report(
         "",
         *(f"- {s.name}: warning: {w}" for s in sequences for w in s.warnings),
     ]
-    with OutputFolder(out_dir, "report.json") as folder:
-        tmp = folder.staging
-        for s in sequences:
-            (tmp / f"{s.name}.events.csv").write_text(
-                events_csv(s.scores.frames, s.aligned.stamps_ns, s.aligned.frame_numbers),
-                encoding="utf-8",
-            )
-        (tmp / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
-        (tmp / "report.json").write_text(
-            json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
+    tmp = folder.staging
+    for s in sequences:
+        (tmp / f"{s.name}.events.csv").write_text(
+            events_csv(s.scores.frames, s.aligned.stamps_ns, s.aligned.frame_numbers),
+            encoding="utf-8",
         )
-        if also is not None:
-            also(tmp, report)
-        folder.commit()
+    (tmp / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
+    (tmp / "report.json").write_text(
+        json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"
+    )
+    if also is not None:
+        also(tmp, report)
+    folder.commit()
     return report

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -101,7 +102,8 @@ def test_calibration_file_round_trip(tmp_path: Path) -> None:
         ("cameras: {c: {translation: [0, 0]}}\n", "translation"),
         ("floor: [0, 0, 1, 0]\n", "cameras"),
         ("cameras: {c: {translation: [0, 0, 1]}}\nfloor: [0, 0, 0, 1]\n", "floor normal"),
-        ("cameras: [\n", "cannot read"),
+        ("cameras: [\n", "not valid YAML"),
+        ("cameras: {}\ncameras: {c: {translation: [0, 0, 1]}}\n", "duplicate key 'cameras'"),
     ],
 )
 def test_bad_calibration_files_are_refused(tmp_path: Path, text: str, message: str) -> None:
@@ -109,6 +111,16 @@ def test_bad_calibration_files_are_refused(tmp_path: Path, text: str, message: s
     path.write_text(text)
     with pytest.raises(ConfigError, match=message):
         load_calibration(path)
+
+
+def test_calibration_that_is_not_utf8_or_a_pipe_is_refused(tmp_path: Path) -> None:
+    latin = tmp_path / "latin.yaml"
+    latin.write_bytes("cameras: {caf\xe9: {translation: [0, 0, 1]}}\n".encode("latin-1"))
+    with pytest.raises(ConfigError, match="not UTF-8"):  # was UnicodeDecodeError
+        load_calibration(latin)
+    os.mkfifo(tmp_path / "pipe.yaml")
+    with pytest.raises(ConfigError, match="named pipe"):  # was a read that never returned
+        load_calibration(tmp_path / "pipe.yaml")
 
 
 def test_missing_calibration_file(tmp_path: Path) -> None:

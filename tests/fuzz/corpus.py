@@ -7,17 +7,21 @@ corrupting what they wrote), and states the documented exit code the CLI must gi
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import struct
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from rgbd_eval.io.groundtruth import write_csv
-from rgbd_eval.io.writer import Container, RecordingWriter
+from rgbd_eval.io.images import encode_depth_raw
+from rgbd_eval.io.messages import CAMERA_INFO_TYPE, IMAGE_TYPE
+from rgbd_eval.io.writer import DEPTH_INFO_TOPIC, Container, RecordingWriter
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, GroundTruthObject, Pose
 from tests.io.conftest import (
     BASE_TO_CAMERA,
@@ -83,6 +87,63 @@ def odd_recording(
                 stamp + 2_000_000, depth(i)[: depth_cam.height, : depth_cam.width], depth_cam
             )
     return path
+
+
+#: Where :func:`damaged_ros1` writes its depth images (16UC1, as the writer's default).
+DAMAGED_DEPTH_TOPIC = "/camera/depth/image_raw"
+
+
+def damaged_ros1(
+    path: Path,
+    damaged: Callable[[int], bool],
+    image: Callable[[dict[str, Any]], dict[str, Any]] | None = None,
+    info: Callable[[Any], Any] | None = None,
+    cut: int = 0,
+) -> Path:
+    """A 4-frame ROS1 bag (odometry, ground truth) whose depth frames ``i`` with
+    ``damaged(i)`` are altered: ``image`` rewrites the Image fields, ``info`` the
+    CameraInfo message, ``cut`` drops that many bytes from the serialised Image."""
+    with RecordingWriter(path, "ros1") as w:
+        w.write_static_transform(T0, "base_link", "camera_link", BASE_TO_CAMERA)
+        w.write_static_transform(T0, "camera_link", "camera_rgb_optical_frame", OPTICAL_TO_BODY)
+        w.write_static_transform(T0, "camera_link", "camera_depth_optical_frame", DEPTH_OFFSET)
+        for k in range(FRAMES * 2 + 4):
+            s = T0 - 20_000_000 + k * 20_000_000
+            w.write_odometry(s, "odom", "base_link", odom_pose(s))
+        for i, obj in enumerate(ground_truth_objects()):
+            stamp = T0 + i * PERIOD
+            w.write_rgb(stamp, rgb_image(i), RGB_CAM)
+            fields = encode_depth_raw(depth_image(i), "16UC1")
+            if damaged(i) and image is not None:
+                fields = image(fields)
+            header = w.header(stamp + 2_000_000, DEPTH_CAM.frame_id, DAMAGED_DEPTH_TOPIC)
+            msg = w._t(IMAGE_TYPE)(header=header, **fields)
+            if damaged(i) and cut:
+                raw = bytes(w.store.serialize_ros1(msg, IMAGE_TYPE))[:-cut]
+                w._writer.write(w._connection(DAMAGED_DEPTH_TOPIC, IMAGE_TYPE), stamp, raw)
+            else:
+                w.write_message(DAMAGED_DEPTH_TOPIC, IMAGE_TYPE, stamp, msg)
+            cam_info = w.camera_info(stamp, DEPTH_CAM, DEPTH_INFO_TOPIC)
+            if damaged(i) and info is not None:
+                cam_info = info(cam_info)
+            w.write_message(DEPTH_INFO_TOPIC, CAMERA_INFO_TYPE, stamp, cam_info)
+            w.write_ground_truth(stamp, "odom", [obj])
+    return path
+
+
+def half_data(fields: dict[str, Any]) -> dict[str, Any]:
+    """An Image whose payload lost its second half (data shorter than step * height)."""
+    return {**fields, "data": fields["data"][: fields["data"].size // 2]}
+
+
+def short_step(fields: dict[str, Any]) -> dict[str, Any]:
+    """An Image whose step is one byte less than a row (width * 2 bytes for 16UC1)."""
+    return {**fields, "step": fields["step"] - 1}
+
+
+def zero_k(msg: Any) -> Any:
+    """A CameraInfo with K all zero (an uncalibrated driver)."""
+    return dataclasses.replace(msg, K=np.zeros(9))
 
 
 def flip_byte(path: Path, offset: int) -> None:
@@ -337,6 +398,22 @@ def _config_cases() -> list[Case]:
         _set_case(
             "threshold_inf", ["evaluation.gating=metric", "evaluation.threshold=.inf"], 4, ""
         ),
+        Case(  # a detector/tracker check was blamed on configs/methods/pinto2022.yaml alone
+            "set_reid_units",
+            "MISLEADING",
+            lambda root: [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "pinto2022",
+                "--set",
+                "detector.reid.backend=mobilenet",
+                "--out",
+                str(root / "out"),
+            ],
+            4,
+            "with --set detector.reid.backend=mobilenet",
+        ),
     ]
 
 
@@ -553,6 +630,201 @@ def _other_command_cases() -> list[Case]:
     ]
 
 
+def _damage_cases() -> list[Case]:
+    """ROS1 bags carry no checksum: damaged messages are checked, skipped and counted;
+    with nothing usable left the recording is refused (exit 3)."""
+
+    def bag(name: str, **kwargs: Any) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            rec = damaged_ros1(root / f"{name}.bag", lambda i: True, **kwargs)
+            return ["run", str(rec), "--out", str(root / "out")]
+
+        return build
+
+    def inspect_all_k_zero(root: Path) -> list[str]:
+        rec = damaged_ros1(root / "kzero.bag", lambda i: True, info=zero_k)
+        return ["inspect", str(rec), "--json"]
+
+    return [
+        Case("ros1_truncated_payload", "SILENT", bag("half", image=half_data), 3, "data holds"),
+        Case("ros1_wrong_step", "SILENT", bag("step", image=short_step), 3, "step 63"),
+        Case("ros1_cut_message", "TRACEBACK", bag("cut", cut=100), 3, "no usable message"),
+        Case("ros1_camera_info_k_zero", "SILENT", bag("kzero", info=zero_k), 3, "K is all zero"),
+        Case("inspect_camera_info_k_zero", "SILENT", inspect_all_k_zero, 3, "K is all zero"),
+    ]
+
+
+# MOTChallenge text: frame,id,x,y,w,h,conf,x,y,z (tracks) and frame,id,x,y,w,h,consider,class,vis.
+MOT_TRACKS = "1,7,0,0,10,10,-1,-1,-1,-1\n2,7,0,0,10,10,-1,-1,-1,-1\n"
+MOT_GT = "1,1,0,0,10,10,1,1,1.0\n2,1,0,0,10,10,1,1,1.0\n"
+
+
+def _score_cases() -> list[Case]:
+    """``score`` checks its output folder before it reads anything, as ``run`` does."""
+
+    def score_into(
+        prepare: Callable[[Path], Path], broken_input: bool = False
+    ) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / "tracks.txt").write_text("1,7,0,0\n" if broken_input else MOT_TRACKS)
+            (root / "gt.txt").write_text(MOT_GT)
+            out = prepare(root)
+            return [
+                "score",
+                str(root / "tracks.txt"),
+                "--gt",
+                str(root / "gt.txt"),
+                "--out",
+                str(out),
+            ]
+
+        return build
+
+    def a_file(root: Path) -> Path:
+        (root / "file.txt").write_text("mine\n")
+        return root / "file.txt"
+
+    def foreign(root: Path) -> Path:
+        (root / "out").mkdir()
+        (root / "out" / "notes.txt").write_text("mine\n")
+        return root / "out"
+
+    def tracks_file(name: str, data: bytes) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / name).write_bytes(data)
+            (root / "gt.txt").write_text(MOT_GT)
+            return [
+                "score",
+                str(root / name),
+                "--gt",
+                str(root / "gt.txt"),
+                "--out",
+                str(root / "o"),
+            ]
+
+        return build
+
+    def tracks_fifo(root: Path) -> list[str]:
+        os.mkfifo(root / "tracks.txt")
+        (root / "gt.txt").write_text(MOT_GT)
+        return ["score", str(root / "tracks.txt"), "--gt", str(root / "gt.txt")]
+
+    header = b"frame,id,bb_left,bb_top,bb_width,bb_height,x,y,z,stamp_ns\n"
+    return [
+        Case(
+            "score_tracks_csv_short_row",
+            "TRACEBACK",
+            tracks_file("t.csv", header + b"1,7,0,0\n"),
+            3,
+            "fewer fields",
+        ),
+        Case(
+            "score_tracks_csv_bad_frame",
+            "TRACEBACK",
+            tracks_file("t.csv", header + b"x,7,0,0,10,10,1,1,1,0\n"),
+            3,
+            "line 2",
+        ),
+        Case("score_tracks_fifo", "HANG", tracks_fifo, 3, "named pipe"),
+        Case("score_out_is_file", "TRACEBACK", score_into(a_file), 7, "not a folder"),
+        Case("score_out_foreign_folder", "DATA-LOSS", score_into(foreign), 7, "--force"),
+        # The output problem is found first: the broken tracks file is never read.
+        Case("score_out_before_input", "ORDER", score_into(a_file, True), 7, "not a folder"),
+        Case("score_bad_tracks", "ORDER", score_into(lambda r: r / "out", True), 3, "lacks"),
+    ]
+
+
+def _model_and_cache_cases() -> list[Case]:
+    def not_a_model(root: Path) -> list[str]:
+        (root / "model.onnx").write_bytes(b"not an onnx model\n" * 10)
+        return [
+            "run",
+            str(good_recording(root)),
+            "--method",
+            "pinto2022",
+            "--set",
+            "detector.person.backend=onnx",
+            "--set",
+            f"detector.person.model={root / 'model.onnx'}",
+            "--out",
+            str(root / "out"),
+        ]
+
+    def det_txt(data: bytes | None) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            det = root / "det.txt"
+            if data is None:
+                os.mkfifo(det)
+            else:
+                det.write_bytes(data)
+            return [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "pinto2022",
+                "--set",
+                "detector.person.backend=recorded",
+                "--set",
+                f"detector.person.source={det}",
+                "--out",
+                str(root / "out"),
+            ]
+
+        return build
+
+    def calibration(data: bytes | None) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            calib = root / "calib.yaml"
+            if data is None:
+                os.mkfifo(calib)
+            else:
+                calib.write_bytes(data)
+            return [
+                "run",
+                str(good_recording(root)),
+                "--method",
+                "dmtbs",
+                "--set",
+                f"detector.calibration={calib}",
+                "--out",
+                str(root / "out"),
+            ]
+
+        return build
+
+    def reproduce_into_file(option: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / "file.txt").write_text("mine\n")
+            # Refused before any scenario is generated (that takes minutes).
+            return ["reproduce", "basso2012", option, str(root / "file.txt")]
+
+        return build
+
+    latin = "1,-1,0,0,10,10,0.9\n# caf\xe9\n".encode("latin-1")
+    return [
+        Case("reproduce_data_is_file", "TRACEBACK", reproduce_into_file("--data"), 7, "--data"),
+        Case("reproduce_out_is_file", "LATE", reproduce_into_file("--out"), 7, "not a folder"),
+        Case("onnx_model_not_a_model", "TRACEBACK", not_a_model, 4, "cannot be loaded"),
+        Case("det_txt_latin1", "TRACEBACK", det_txt(latin), 3, "not UTF-8"),
+        Case("det_txt_fifo", "HANG", det_txt(None), 3, "named pipe"),
+        Case(
+            "calibration_latin1",
+            "TRACEBACK",
+            calibration("a: caf\xe9\n".encode("latin-1")),
+            4,
+            "not UTF-8",
+        ),
+        Case("calibration_fifo", "HANG", calibration(None), 4, "named pipe"),
+        Case(
+            "calibration_dup_key",
+            "SILENT",
+            calibration(b"cameras: {}\ncameras: {}\n"),
+            4,
+            "duplicate",
+        ),
+    ]
+
+
 def all_cases() -> list[Case]:
     """Every case of the corpus."""
     return [
@@ -563,6 +835,9 @@ def all_cases() -> list[Case]:
         *_output_cases(),
         *_compare_cases(),
         *_other_command_cases(),
+        *_damage_cases(),
+        *_score_cases(),
+        *_model_and_cache_cases(),
     ]
 
 

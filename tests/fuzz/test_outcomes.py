@@ -9,19 +9,26 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
 from rgbd_eval.io.groundtruth import write_csv
+from rgbd_eval.io.writer import DEPTH_INFO_TOPIC
 from tests.fuzz.cli import leftovers, run_cli
 from tests.fuzz.corpus import (
+    DAMAGED_DEPTH_TOPIC,
     FRAMES,
+    damaged_ros1,
     flip_byte,
     good_recording,
     ground_truth_objects,
+    half_data,
     odd_recording,
+    short_step,
     without_statistics,
+    zero_k,
 )
 from tests.io.conftest import depth_image
 
@@ -145,3 +152,89 @@ def test_mcap_without_statistics_is_read_not_called_empty(
     assert result.code == 0, result.stderr  # was exit 3, "recording is empty (no messages)"
     report = json.loads((out / "report.json").read_text())
     assert report["sequences"][0]["frames"] == FRAMES and report["sequences"][0]["scored"]
+
+
+DAMAGE: dict[str, tuple[dict[str, Any], str, str]] = {
+    "truncated_payload": ({"image": half_data}, DAMAGED_DEPTH_TOPIC, "data holds 768 bytes"),
+    "wrong_step": ({"image": short_step}, DAMAGED_DEPTH_TOPIC, "step 63 is less than"),
+    "cut_message": ({"cut": 100}, DAMAGED_DEPTH_TOPIC, "sequence length"),
+    "camera_info_k_zero": ({"info": zero_k}, DEPTH_INFO_TOPIC, "K is all zero"),
+}
+
+
+@pytest.mark.parametrize("damage", list(DAMAGE), ids=list(DAMAGE))
+def test_a_damaged_ros1_message_is_skipped_counted_and_reported(
+    damage: str, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    kwargs, topic, problem = DAMAGE[damage]
+    # Frame 0's depth Image (or its CameraInfo, the first one, which the camera model
+    # used to come from) is damaged; frames 1..3 are intact.
+    rec = damaged_ros1(tmp_path / "damaged.bag", lambda i: i == 0, **kwargs)
+    out = tmp_path / "out"
+    result = run_cli(["run", str(rec), "--out", str(out)], capsys)
+    assert result.code == 0, result.stderr
+    warning = f"damaged messages skipped: {topic} 1 of {FRAMES} ("
+    assert warning in result.stdout and problem in result.stdout
+    seq = json.loads((out / "report.json").read_text())["sequences"][0]
+    assert [(s["topic"], s["count"], s["total"]) for s in seq["skipped_messages"]] == [
+        (topic, 1, FRAMES)
+    ]
+    assert any(warning in w for w in seq["warnings"])
+    # A lost depth image loses its frame (its RGB partner is dropped, unpaired); a lost
+    # CameraInfo loses nothing (the camera model comes from the next one).
+    assert seq["frames"] == (FRAMES if topic == DEPTH_INFO_TOPIC else FRAMES - 1)
+    assert seq["scored"]
+    inspected = run_cli(["inspect", str(rec), "--json"], capsys)
+    assert inspected.code == 0, inspected.stderr
+    skipped = json.loads(inspected.stdout)["recording"]["skipped"]
+    assert [(s["topic"], s["count"]) for s in skipped] == [(topic, 1)]
+
+
+def test_score_force_writes_into_a_foreign_folder_and_keeps_its_files(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from tests.fuzz.corpus import MOT_GT, MOT_TRACKS
+
+    (tmp_path / "tracks.txt").write_text(MOT_TRACKS)
+    (tmp_path / "gt.txt").write_text(MOT_GT)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    args = ["score", str(tmp_path / "tracks.txt"), "--gt", str(tmp_path / "gt.txt")]
+    assert run_cli([*args, "--out", str(out)], capsys).code == 7
+    result = run_cli([*args, "--out", str(out), "--force"], capsys)
+    assert result.code == 0, result.stderr
+    assert (out / "notes.txt").read_text() == "mine\n"
+    # 2 frames, one person, one track on it in both: MOTA 1.
+    assert json.loads((out / "report.json").read_text())["sequences"][0]["metrics"]["mota"] == 1.0
+    # A re-run replaces what score wrote and still keeps the user's file, without --force.
+    assert run_cli([*args, "--out", str(out)], capsys).code == 0
+    assert (out / "notes.txt").is_file() and leftovers(tmp_path) == []
+
+
+def test_a_corrupt_npz_cache_entry_is_recomputed_with_one_warning(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = good_recording(tmp_path)
+    cache = tmp_path / "cache"
+    args = ["sweep", "tracker.min_confidence", "-1", "0", "--dataset", str(rec)]
+    args += ["--cache", str(cache), "--cluster", "local:1"]
+    first = run_cli([*args, "--out", str(tmp_path / "s1")], capsys)
+    assert first.code == 0, first.stderr
+    (entry,) = list(cache.rglob("*.det"))  # a header and sha256, then the .npz payload
+    # The .npz lost its last third (its zip central directory), as a full disk leaves it.
+    entry.write_bytes(entry.read_bytes()[: entry.stat().st_size * 2 // 3])
+    second = run_cli([*args, "--out", str(tmp_path / "s2")], capsys)
+    assert second.code == 0, second.stderr
+    assert "Traceback" not in second.stderr
+    warnings = [line for line in second.stderr.splitlines() if line.startswith("warning:")]
+    assert len(warnings) == 1 and "recomputing" in warnings[0], second.stderr
+
+    # The same numbers as from intact detections; the entry is intact again.
+    def counts(folder: str) -> list[dict[str, object]]:  # the records without their timings
+        data = json.loads((tmp_path / folder / "sweep.json").read_text())
+        return [{k: v for k, v in r.items() if "second" not in k} for r in data["records"]]
+
+    assert counts("s1") == counts("s2") and len(counts("s1")) == 2
+    third = run_cli([*args, "--out", str(tmp_path / "s3")], capsys)
+    assert third.code == 0 and "warning:" not in third.stderr

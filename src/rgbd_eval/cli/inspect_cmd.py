@@ -115,6 +115,11 @@ def _print_human(data: dict[str, Any]) -> None:
         console.print(
             f"tf chain: none (no odometry; world = camera frame {info['camera_frame']!r})"
         )
+    for sk in info.get("skipped", ()):
+        console.print(
+            f"skipped {sk['topic']}: {sk['count']} of {sk['total']} messages damaged "
+            f"(first: {sk['first_problem']})"
+        )
     for w in info["warnings"]:
         console.print(f"[yellow]warning:[/] {w}")
     if not data["ground_truth"]:

@@ -16,6 +16,8 @@ from rgbd_eval.cli.common import (
     err_console,
     handle_errors,
 )
+from rgbd_eval.errors import OutputError
+from rgbd_eval.outdir import OutputFolder
 
 
 @handle_errors
@@ -33,6 +35,10 @@ def reproduce(
         Path | None,
         typer.Option(help="folder of the generated recordings (default: the datasets folder)"),
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
 ) -> None:
     """Redo a paper's experiments on synthetic scenarios (generated if absent)."""
     from rgbd_eval.plugins import ReproduceOptions, known, paper_spec
@@ -48,19 +54,25 @@ def reproduce(
     from rgbd_eval.report_html import reproduce_page
     from rgbd_eval.sim import ensure_scenario
 
-    recordings = {
-        Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
-        for name in spec.scenarios
-    }
+    if data is not None and data.exists() and not data.is_dir():  # was FileExistsError
+        raise OutputError(data, "--data is not a folder (it holds the generated recordings)")
     out_dir = out or Path("runs") / f"reproduce-{system}-{time.strftime('%Y%m%d-%H%M%S')}"
-    with connect(parse_cluster(cluster_of(cluster, jobs))) as client:
-        options = ReproduceOptions(
-            client=client, cache=cache, progress=lambda m: err_console.print(m)
-        )
-        result = spec.run(recordings, options)
-    write_text(out_dir / "reproduce.md", result.markdown)
-    write_json(out_dir / "reproduce.json", {"method": system, **result.data})
-    write_text(out_dir / "reproduce.html", reproduce_page(result, system))
+    # The output folder is checked and staged before the scenarios are generated and run.
+    with OutputFolder(out_dir, "reproduce.json", force) as folder:
+        recordings = {
+            Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
+            for name in spec.scenarios
+        }
+        with connect(parse_cluster(cluster_of(cluster, jobs))) as client:
+            options = ReproduceOptions(
+                client=client, cache=cache, progress=lambda m: err_console.print(m)
+            )
+            result = spec.run(recordings, options)
+        staging = folder.staging
+        write_text(staging / "reproduce.md", result.markdown)
+        write_json(staging / "reproduce.json", {"method": system, **result.data})
+        write_text(staging / "reproduce.html", reproduce_page(result, system))
+        folder.commit()
     console.print(result.markdown, markup=False)
     held = sum(ok for _, ok in result.claims)
     if result.claims:

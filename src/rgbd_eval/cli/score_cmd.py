@@ -13,6 +13,7 @@ from rich.table import Table
 from rgbd_eval.cli.common import CLUSTER_HELP, ConfigOption, SetOption, console, handle_errors
 from rgbd_eval.config import load_config
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.outdir import OutputFolder
 
 
 @handle_errors
@@ -54,6 +55,10 @@ def score(
     cluster: Annotated[
         str | None, typer.Option(help=f"{CLUSTER_HELP} (default: in this process)")
     ] = None,
+    force: Annotated[
+        bool,
+        typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
+    ] = False,
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
@@ -71,26 +76,31 @@ def score(
         known = ", ".join(b.value for b in Benchmark)
         raise ConfigError(f"--benchmark {benchmark!r}: expected one of {known}") from err
     max_gap_ns = int(config.io.max_sync_gap_ms * 1e6)
-    pairs = sequence_pairs(tracks, gt)
-    rest = (config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame)
-    if cluster is None:
-        sequences = [score_sequence(name, t, g, *rest) for name, t, g in pairs]
-    else:  # a task per sequence; results come back, this process writes the report
-        from rgbd_eval.engine import connect, map_ordered, parse_cluster
-
-        spec = parse_cluster(cluster, tasks=len(pairs))
-        if spec.address is not None:  # remote workers do not share our working directory
-            pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
-        with connect(spec) as client:
-            sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"
-    report = write_report(
-        out_dir,
-        sequences,
-        config.evaluation,
-        max_gap_ns,
-        lambda folder, rep: write_score_html(folder, sequences, rep, config.evaluation.gating),
-    )
+    folder = OutputFolder(out_dir, "report.json", force)
+    # The output folder is checked and staged before any input is read, as for run.
+    with folder:
+        pairs = sequence_pairs(tracks, gt)
+        rest = (config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame)
+        if cluster is None:
+            sequences = [score_sequence(name, t, g, *rest) for name, t, g in pairs]
+        else:  # a task per sequence; results come back, this process writes the report
+            from rgbd_eval.engine import connect, map_ordered, parse_cluster
+
+            spec = parse_cluster(cluster, tasks=len(pairs))
+            if spec.address is not None:  # remote workers do not share our working directory
+                pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
+            with connect(spec) as client:
+                sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
+        report = write_report(
+            folder,
+            sequences,
+            config.evaluation,
+            max_gap_ns,
+            lambda staging, rep: write_score_html(
+                staging, sequences, rep, config.evaluation.gating
+            ),
+        )
     if json_out:
         typer.echo(json.dumps(report, indent=2))
         return

@@ -203,7 +203,7 @@ def sweep(
             )
         wall = time.perf_counter() - start
         for warning in result.warnings:
-            err_console.print(f"warning: {warning}", markup=False, highlight=False)
+            err_console.print(f"warning: {warning}", markup=False, highlight=False, soft_wrap=True)
         if not result.records:  # nothing scored: no output folder, one error line
             raise _failed(result, "")
         _write_outputs(folder, result, wall, method, recordings, fixed, g, spec.describe())

@@ -21,12 +21,12 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-import yaml
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from rgbd_eval.detect.plane import normalise_plane, ransac_ground_plane
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.files import parse_yaml, read_text
 from rgbd_eval.types import CameraModel, Pose
 
 FloatArray = NDArray[np.float64]
@@ -167,10 +167,12 @@ class CalibrationFile(BaseModel):
 
 def load_calibration(path: Path) -> CalibrationFile:
     """Read and validate a calibration YAML; :class:`ConfigError` on any problem."""
-    try:
-        raw = yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise ConfigError(f"{path}: cannot read calibration: {err}") from err
+
+    # A regular, bounded UTF-8 file, strict YAML (duplicate keys and alias bombs refused).
+    def error(message: str) -> ConfigError:
+        return ConfigError(f"{path}: {message}")
+
+    raw = parse_yaml(read_text(Path(path), error, "calibration"), error)
     try:
         calibration = CalibrationFile.model_validate(raw)
     except ValidationError as err:

@@ -26,6 +26,7 @@ from typing import Any
 
 from rgbd_eval.detect.person2d import ColourImage, PersonBox
 from rgbd_eval.errors import InputError
+from rgbd_eval.files import read_text
 from rgbd_eval.io.messages import BOUNDING_BOXES_TYPE, DETECTION2D_ARRAY_TYPE
 from rgbd_eval.io.source import READ_ERRORS, open_source
 from rgbd_eval.types import Box2D
@@ -138,26 +139,25 @@ class RecordedDetector:
         """A MOTChallenge ``det.txt`` (frames from 1)."""
         params = params or RecordedParams()
         by_frame: dict[int, list[PersonBox]] = {}
+        # A regular, bounded UTF-8 file (a pipe would block, Latin-1 raised UnicodeDecodeError).
+        text = read_text(path, lambda m: InputError(path, m), "detections")
         try:
-            with path.open(newline="") as handle:
-                for line_no, row in enumerate(csv.reader(handle), start=1):
-                    if not row or not "".join(row).strip():
-                        continue
-                    if len(row) < 7:
-                        raise InputError(path, f"line {line_no}: {len(row)} fields, expected >= 7")
-                    try:
-                        frame = int(float(row[0]))
-                        left, top, w, h, conf = (float(v) for v in row[2:7])
-                    except ValueError as err:
-                        raise InputError(path, f"line {line_no}: not a number ({err})") from err
-                    if frame < 1:
-                        raise InputError(path, f"line {line_no}: frame {frame} < 1")
-                    if w > 0 and h > 0 and conf >= params.min_score:
-                        by_frame.setdefault(frame, []).append(
-                            PersonBox(Box2D(left, top, w, h), conf)
-                        )
-        except OSError as err:
-            raise InputError(path, f"cannot read: {err.strerror}") from err
+            for line_no, row in enumerate(csv.reader(text.splitlines()), start=1):
+                if not row or not "".join(row).strip():
+                    continue
+                if len(row) < 7:
+                    raise InputError(path, f"line {line_no}: {len(row)} fields, expected >= 7")
+                try:
+                    frame = int(float(row[0]))
+                    left, top, w, h, conf = (float(v) for v in row[2:7])
+                except ValueError as err:
+                    raise InputError(path, f"line {line_no}: not a number ({err})") from err
+                if frame < 1:
+                    raise InputError(path, f"line {line_no}: frame {frame} < 1")
+                if w > 0 and h > 0 and conf >= params.min_score:
+                    by_frame.setdefault(frame, []).append(PersonBox(Box2D(left, top, w, h), conf))
+        except csv.Error as err:
+            raise InputError(path, f"not CSV text ({err})") from err
         return cls(by_frame=by_frame, params=params)
 
     def detect(self, image: ColourImage) -> list[PersonBox]:

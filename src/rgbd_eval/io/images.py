@@ -42,7 +42,13 @@ class ImageFormatError(ValueError):
     """An image message cannot be decoded; the reader adds file and topic."""
 
 
-def _bytes_per_pixel(encoding: str) -> tuple[int, str]:
+def bytes_per_pixel(encoding: str) -> tuple[int, int]:
+    """``(channels, bytes per channel)`` of a raw ``Image`` encoding (ImageFormatError if unknown)."""
+    channels, kind = _pixel_layout(encoding)
+    return channels, np.dtype(kind).itemsize
+
+
+def _pixel_layout(encoding: str) -> tuple[int, str]:
     table = {
         "rgb8": (3, "u1"),
         "bgr8": (3, "u1"),
@@ -61,7 +67,7 @@ def _bytes_per_pixel(encoding: str) -> tuple[int, str]:
 
 def image_array(msg: Any) -> NDArray[Any]:
     """The pixel array of a ``sensor_msgs/Image``, row padding removed, native byte order."""
-    channels, kind = _bytes_per_pixel(msg.encoding)
+    channels, kind = _pixel_layout(msg.encoding)
     dtype = np.dtype(kind).newbyteorder(">" if msg.is_bigendian else "<")
     height, width, step = int(msg.height), int(msg.width), int(msg.step)
     row_bytes = width * channels * dtype.itemsize

@@ -20,7 +20,6 @@ Reading takes two passes, so memory stays flat in the sequence length:
 from __future__ import annotations
 
 import math
-import struct
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,7 +38,8 @@ from rgbd_eval.errors import (
     TransformError,
 )
 from rgbd_eval.files import check_input
-from rgbd_eval.io import groundtruth, images, validate
+from rgbd_eval.io import groundtruth, images, integrity, validate
+from rgbd_eval.io.integrity import SkippedMessages
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -48,7 +48,7 @@ from rgbd_eval.io.messages import (
     ODOMETRY_TYPE,
     TF_TYPE,
 )
-from rgbd_eval.io.source import READ_ERRORS, MessageSource, open_source
+from rgbd_eval.io.source import MESSAGE_ERRORS, READ_ERRORS, MessageSource, open_source
 from rgbd_eval.io.sync import Pairing, first_non_increasing, pair_nearest
 from rgbd_eval.io.tf import TfBuffer, TransformLookupError
 from rgbd_eval.plugins import StreamSpec, role_kind
@@ -141,6 +141,8 @@ class RecordingInfo:
     has_odometry: bool
     num_frames: int
     warnings: tuple[str, ...] = field(default_factory=tuple)
+    #: Damaged messages skipped per topic (:mod:`rgbd_eval.io.integrity`).
+    skipped: tuple[SkippedMessages, ...] = field(default_factory=tuple)
 
     @property
     def rgb_camera(self) -> CameraModel | None:
@@ -164,16 +166,6 @@ def container_kind(path: Path) -> str:
     raise InputError(
         path, "unsupported file type (expected .bag, .mcap, .db3 or a ROS2 bag folder)"
     )
-
-
-def _header_stamp(raw: bytes | memoryview, ros1: bool) -> int:
-    """Header stamp of a message whose first field is ``std_msgs/Header``, from the raw bytes."""
-    if ros1:  # uint32 seq, uint32 sec, uint32 nsec
-        sec, nsec = struct.unpack_from("<II", raw, 4)
-    else:  # 4-byte CDR encapsulation header, then int32 sec, uint32 nanosec
-        endian = "<" if raw[1] & 1 else ">"
-        sec, nsec = struct.unpack_from(endian + "iI", raw, 4)
-    return int(sec) * 1_000_000_000 + int(nsec)
 
 
 def _stamp_of(msg: Any) -> int:
@@ -217,6 +209,12 @@ class _Index:
     """Everything the index pass collects."""
 
     stamps: dict[str, list[int]] = field(default_factory=dict)
+    #: Per image topic: the position among the topic's messages of each stamp kept.
+    ordinals: dict[str, list[int]] = field(default_factory=dict)
+    #: Per raw image topic: (width, height) of each message kept.
+    sizes: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
+    totals: dict[str, int] = field(default_factory=dict)
+    skips: integrity.SkipLog = field(default_factory=integrity.SkipLog)
     log_stamps: dict[str, list[int]] = field(default_factory=dict)
     first_msgs: dict[str, Any] = field(default_factory=dict)
     tf: TfBuffer = field(default_factory=TfBuffer)
@@ -521,14 +519,37 @@ def open_recording(
                 raise InputError(path, "recording is empty (no messages)")
             by_topic = {c.topic: c for c in conns}
             duration_s = max(0.0, (src.end_ns - src.start_ns) / 1e9)
-            # Classify image topics by their first message.
+            # Classify image topics by their first message that deserialises (a topic
+            # none of whose messages does is left out, and named when a role lacks a topic).
             image_conns = [c for c in conns if c.msgtype in _IMAGE_TYPES and c.count > 0]
             first: dict[str, Any] = {}
+            undecodable: dict[str, str] = {}
             for conn in image_conns:
                 for _, _, raw in src.messages({conn.topic}):
-                    first[conn.topic] = src.deserialize(raw, conn.msgtype)
+                    try:
+                        first[conn.topic] = src.deserialize(raw, conn.msgtype)
+                    except MESSAGE_ERRORS as err:
+                        undecodable.setdefault(conn.topic, str(err))
+                        continue
                     break
-            chosen = _choose_streams(path, io, streams, first)
+            if undecodable.keys() - first.keys():
+                warnings.append(
+                    "image topics with no decodable message left out: "
+                    + ", ".join(
+                        f"{t} ({undecodable[t]})" for t in sorted(undecodable.keys() - first.keys())
+                    )
+                )
+            try:
+                chosen = _choose_streams(path, io, streams, first)
+            except TopicError as err:
+                lost = sorted(undecodable.keys() - first.keys())
+                if not lost:
+                    raise
+                raise DecodeError(  # the topic the role needed may be the damaged one
+                    path,
+                    f"no usable message: every message is damaged ({undecodable[lost[0]]})",
+                    lost[0],
+                ) from err
             if not chosen:
                 raise TopicError(
                     path,
@@ -575,18 +596,31 @@ def open_recording(
     )
     cameras = _cameras(path, selected, index, first, warnings)
 
+    _skip_wrong_sizes(index, selected, cameras)
     stamps = {}
+    ordinals: dict[str, NDArray[np.int64]] = {}
     for role, topic in chosen.items():
         arr = np.asarray(index.stamps.get(topic, []), dtype=np.int64)
+        ordinals[role] = np.asarray(index.ordinals.get(topic, []), dtype=np.int64)
+        if arr.size == 0 and topic in index.skips.counts:
+            raise DecodeError(
+                path,
+                f"no usable message: all {index.skips.counts[topic]} are damaged "
+                f"({index.skips.first[topic]})",
+                topic,
+            )
         bad = first_non_increasing(arr)
         if bad is not None:
             raise SyncError(
                 path,
-                f"header stamps are not increasing at message {bad} "
+                f"header stamps are not increasing at message {int(ordinals[role][bad])} "
                 f"({int(arr[bad - 1])} then {int(arr[bad])} ns)",
                 topic,
             )
         stamps[role] = arr
+    skipped = index.skips.summary(index.totals)
+    if (skip_note := integrity.skipped_warning(skipped)) is not None:
+        warnings.append(skip_note)
     reference = next(iter(chosen))
     max_gap_ns = int(io.max_sync_gap_ms * 1e6)
     partner: dict[str, dict[int, int]] = {}
@@ -637,7 +671,7 @@ def open_recording(
         if not all(r in partner[role] for role in partner):
             continue
         stamp = int(ref_stamps[r])
-        messages = {reference: r, **{role: partner[role][r] for role in partner}}
+        kept = {reference: r, **{role: partner[role][r] for role in partner}}
         if has_odometry:
             try:
                 pose = index.tf.lookup(world_frame, camera_frame, stamp, tol)
@@ -652,11 +686,13 @@ def open_recording(
         plan.append(
             _FramePlan(
                 stamp,
-                messages,
-                {role: int(stamps[role][i]) for role, i in messages.items()},
+                {role: int(ordinals[role][i]) for role, i in kept.items()},  # topic positions
+                {role: int(stamps[role][i]) for role, i in kept.items()},
                 poses,
             )
         )
+    if not plan and skipped:
+        raise DecodeError(path, f"no usable frame left: {skip_note}")
     if not plan:
         if partner and not any(partner.values()):
             raise SyncError(path, "no frame has every stream within the sync gap")
@@ -707,8 +743,33 @@ def open_recording(
         has_odometry=has_odometry,
         num_frames=len(plan),
         warnings=tuple(warnings),
+        skipped=skipped,
     )
     return Recording(path, io, info, plan, depth_to_rgb, gt)
+
+
+def _skip_wrong_sizes(
+    index: _Index, sel: SelectedTopics, cameras: Mapping[str, CameraModel]
+) -> None:
+    """Skip raw image messages whose size is not their camera's (CameraInfo) size."""
+    for role, topic in sel.streams.items():
+        sizes = index.sizes.get(topic)
+        if not sizes:
+            continue
+        cam = cameras[role]
+        keep = [k for k, size in enumerate(sizes) if size == (cam.width, cam.height)]
+        if len(keep) == len(sizes):
+            continue
+        for w, h in sizes:
+            if (w, h) != (cam.width, cam.height):
+                index.skips.add(
+                    topic,
+                    f"image is {w}x{h} but its CameraInfo ({sel.infos.get(role)}) says "
+                    f"{cam.width}x{cam.height}",
+                )
+        index.stamps[topic] = [index.stamps[topic][k] for k in keep]
+        index.ordinals[topic] = [index.ordinals[topic][k] for k in keep]
+        index.sizes[topic] = [sizes[k] for k in keep]
 
 
 def _smallest_gap_ms(a: NDArray[np.int64], b: NDArray[np.int64]) -> float:
@@ -738,13 +799,32 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics) -> _Index:
     wanted = small | images_
     for topic, log_ns, raw in src.messages(wanted):
         msgtype = src.topics[topic].msgtype
+        ordinal = index.totals.get(topic, 0)
+        index.totals[topic] = ordinal + 1
+        try:  # against its definition: the bytes must deserialise, exactly consumed
+            msg: Any = src.deserialize(raw, msgtype)
+        except MESSAGE_ERRORS as err:
+            if topic == sel.ground_truth:  # annotations are never dropped silently
+                raise InputError(path, f"ground-truth message {ordinal}: {err}", topic) from err
+            index.skips.add(topic, str(err))
+            continue
         if topic in images_:
-            index.stamps.setdefault(topic, []).append(_header_stamp(raw, src.ros1))
+            problem = integrity.image_problem(msg)
+            if problem is not None:
+                index.skips.add(topic, problem)
+                continue
+            index.stamps.setdefault(topic, []).append(_stamp_of(msg))
+            index.ordinals.setdefault(topic, []).append(ordinal)
+            if not hasattr(msg, "format"):
+                index.sizes.setdefault(topic, []).append((int(msg.width), int(msg.height)))
             continue
         index.log_stamps.setdefault(topic, []).append(log_ns)
-        msg: Any = src.deserialize(raw, msgtype)
         if topic in infos:
-            index.first_msgs.setdefault(topic, msg)
+            problem = integrity.camera_info_problem(msg)
+            if problem is not None:
+                index.skips.add(topic, problem)
+            else:
+                index.first_msgs.setdefault(topic, msg)
         elif topic == sel.odometry:
             parent, child = msg.header.frame_id.lstrip("/"), msg.child_frame_id.lstrip("/")
             index.odom_frames = (parent, child)
@@ -815,6 +895,13 @@ def _cameras(
         topic = sel.streams[role]
         info_topic = sel.infos.get(role)
         msg = index.first_msgs.get(info_topic) if info_topic else None
+        if msg is None and info_topic is not None and info_topic in index.skips.counts:
+            raise DecodeError(
+                path,
+                f"no usable CameraInfo: all {index.skips.counts[info_topic]} messages are "
+                f"damaged ({index.skips.first[info_topic]})",
+                info_topic,
+            )
         if msg is None:
             colour = cameras.get("colour")
             img = first[topic]
@@ -848,16 +935,6 @@ def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str
         camera = camera_model_from_info(msg)
     except ValueError as err:
         raise DecodeError(path, f"bad CameraInfo: {err}", info_topic) from err
-    if not hasattr(first, "format") and (int(first.width), int(first.height)) != (
-        camera.width,
-        camera.height,
-    ):
-        raise DecodeError(
-            path,
-            f"image is {first.width}x{first.height} but its CameraInfo ({info_topic}) says "
-            f"{camera.width}x{camera.height}",
-            topic,
-        )
     if not camera.frame_id:
         camera = CameraModel(
             camera.width,

@@ -49,6 +49,10 @@ READ_ERRORS: tuple[type[BaseException], ...] = (
     sqlite3.Error,
 )
 
+#: Exceptions of deserialising one message whose bytes do not match its definition
+#: (rosbags wraps struct/unicode/size errors in SerdeError; an unknown type is ValueError).
+MESSAGE_ERRORS: tuple[type[BaseException], ...] = (SerdeError, ValueError)
+
 
 @dataclass(frozen=True)
 class TopicConnection:
@@ -107,14 +111,21 @@ class AnyReaderSource(MessageSource):
         conns = [c for t, c in self._conns.items() if t in topics]
         if not conns:
             return
-        for conn, log_ns, raw in self._reader.messages(connections=conns):
-            yield conn.topic, log_ns, raw
+        try:
+            for conn, log_ns, raw in self._reader.messages(connections=conns):
+                yield conn.topic, log_ns, raw
+        except AssertionError as err:
+            # rosbags' ROS1 reader asserts that a message record's time equals its index
+            # entry's: a flipped byte in either was an AssertionError traceback.
+            raise Ros1ReaderError("index and message record disagree: the bag is corrupt") from err
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
         try:
             return self._reader.deserialize(bytes(raw), msgtype)
         except KeyError as err:  # a damaged type table names a type the typestore lacks
             raise ValueError(f"message type {msgtype!r} has no definition") from err
+        except AnyReaderError as err:  # AnyReader wraps the SerdeError of one message
+            raise SerdeError(str(err)) from err
 
     def close(self) -> None:
         self._reader.close()

@@ -30,6 +30,7 @@ from pathlib import Path
 import numpy as np
 
 from rgbd_eval.errors import GroundTruthError, InputError
+from rgbd_eval.files import check_input
 from rgbd_eval.io.groundtruth import GroundTruth, from_objects, load_ground_truth, read_ktp
 from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, Visibility
 
@@ -235,7 +236,12 @@ def read_tracks_csv(path: Path) -> TrackerOutput:
                 raise InputError(path, f"tracks CSV lacks the column(s) {missing}")
             by_frame: dict[int, tuple[int, list[TrackOutput]]] = {}
             for number, row in enumerate(reader, start=2):
+                if None in row:  # csv.DictReader files extra fields under the key None
+                    raise InputError(path, f"line {number}: more fields than the header")
+                if None in row.values():  # ... and fills missing ones with None
+                    raise InputError(path, f"line {number}: fewer fields than the header")
                 try:
+                    frame = int(row["frame"])
                     box = [_float(row[k]) for k in _TRACKS_CSV_REQUIRED[2:6]]
                     stamp = int(row.get("stamp_ns") or 0)
                     z = _float(row.get("z"))
@@ -253,7 +259,6 @@ def read_tracks_csv(path: Path) -> TrackerOutput:
                     )
                 except (ValueError, KeyError) as err:
                     raise InputError(path, f"line {number}: {err}") from err
-                frame = int(row["frame"])
                 entry = by_frame.setdefault(frame, (stamp, []))
                 if entry[0] != stamp:
                     raise InputError(path, f"line {number}: frame {frame} has two stamps")
@@ -316,8 +321,7 @@ def load_tracks(
         from rgbd_eval.io.track_messages import read_bag_tracks
 
         return read_bag_tracks(path, topic, world_frame)
-    if not path.is_file():
-        raise InputError(path, "tracker output not found")
+    check_input(path, lambda m: InputError(path, m), "tracker output")  # no pipe, no device
     if is_mot_text(path):
         return read_mot_tracks(path)
     if "," in _first_data_line(path) and ":" not in _first_data_line(path):
@@ -328,8 +332,7 @@ def load_tracks(
 def load_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> tuple[GroundTruth, int | None]:
     """Ground truth for scoring and the sequence length where a ``seqinfo.ini`` states it."""
     path = Path(path)
-    if not path.is_file():
-        raise GroundTruthError(path, "ground-truth file not found")
+    check_input(path, lambda m: GroundTruthError(path, m), "ground truth")
     if is_mot_text(path):
         return read_mot_gt(path, benchmark), seq_length(path)
     return load_ground_truth(path), None
