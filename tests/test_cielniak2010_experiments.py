@@ -117,3 +117,12 @@ def test_a_missing_switch_counts_as_off() -> None:
     assert runnable == {"off": {"tracker.seed": 1}, "known": {"tracker.seed": 2}}
     assert set(skipped) == {"on"}
     assert "no_such_switch" in skipped["on"]
+
+
+def test_html_page_reads_the_paper_file() -> None:
+    from rgbd_eval.plugins import ReproduceResult
+    from rgbd_eval.report_html import reproduce_page
+
+    claim = {"sentence": "s", "source": "section 7", "evidence": "e", "held": True}
+    result = ReproduceResult(markdown="# x\n", data={"claims": [claim]}, claims=(("s", True),))
+    assert "section 7" in reproduce_page(result, "cielniak2010")
