@@ -1,5 +1,5 @@
 """The cielniak2010 tracker: thermal-to-colour boxes, frame requirement, method config,
-the warm-region proposals, the standing-height prior and the stand-in occlusion order."""
+the warm-region proposals, the standing-height prior and the occlusion order the tracker calls."""
 
 from __future__ import annotations
 
@@ -86,7 +86,9 @@ def test_implied_height_of_a_person_on_the_floor_hand_computed() -> None:
     assert prior.tolist() == pytest.approx([0.0, -2.0, HeightPrior().no_floor])
 
 
-def test_stand_in_order_puts_the_lower_feet_in_front() -> None:
+def test_order_on_a_blank_image_puts_the_lower_feet_in_front() -> None:
+    # The shipped AdaBoost classifier with nothing to measure but the boxes: on a level
+    # floor the nearer person's feet are lower in the image.
     near = np.array([100.0, 40.0, 140.0, 200.0])  # feet at v = 200
     far = np.array([120.0, 60.0, 150.0, 150.0])  # feet at v = 150
     thermal = np.zeros((240, 320))

@@ -305,6 +305,9 @@ class Sensor(_Model):
         0.08, ge=0.0, le=0.8, description="relative amplitude of slow exposure changes"
     )
     exposure_period_s: float = Field(11.0, gt=0.1, le=1000.0)
+    illumination: float = Field(
+        1.0, ge=0.0, le=2.0, description="scene light level (1: office light; 0.03: darkness)"
+    )
     light_azimuth_deg: float = Field(30.0, ge=-360.0, le=360.0)
     light_elevation_deg: float = Field(55.0, ge=0.0, le=90.0)
 

@@ -229,7 +229,7 @@ class Simulator:
         hits = self._render(people_mesh, people_scene, self.rgb_camera, rgb_pose)
         clean = shade(mesh, hits, self.light, sc.room.floor_tile)
         ids = object_ids(mesh, hits)
-        gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s)
+        gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s) * s.illumination
         noise = frame_noise(self._noise, _rng(self.seed, _STREAM_RGB, index))
         rgb = noisy_rgb(clean, gain, s.rgb_noise_std, noise)
 
