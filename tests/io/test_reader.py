@@ -130,3 +130,17 @@ def test_sync_drops_and_counts_unpaired(make_recording: Callable[..., Path]) -> 
     assert [(x.role, x.dropped) for x in s.streams] == [("colour", 2), ("depth", 2)]
     assert s.worst_gap_ms == pytest.approx(1.0)
     assert [f.stamp_ns for f in rec.frames()] == [rgb[0], rgb[1], rgb[3]]
+
+
+@pytest.mark.parametrize(
+    ("container", "suffix"), [("ros2-sqlite3", ".db3"), ("ros2-mcap", ".mcap")]
+)
+def test_ros2_folder_keeps_no_temporary_names(
+    make_recording: Callable[..., Path], container: str, suffix: str
+) -> None:
+    # The folder is written under a temporary name and renamed; its storage file and
+    # metadata.yaml must carry the recording's name, as `ros2 bag` would write them.
+    path = make_recording(container, Spec())
+    assert sorted(p.name for p in path.iterdir()) == sorted(["metadata.yaml", path.name + suffix])
+    assert ".tmp-" not in (path / "metadata.yaml").read_text()
+    assert len(open_recording(path)) == 5

@@ -16,6 +16,7 @@ from types import TracebackType
 from typing import Any, Literal
 
 import numpy as np
+import yaml
 from mcap.writer import CompressionType
 from mcap.writer import Writer as McapWriter
 from numpy.typing import NDArray
@@ -152,8 +153,30 @@ class RecordingWriter:
             self._mcap_file.close()
         else:
             self._writer.close()
+            if self.container != "ros1":
+                self._name_storage_files()
         self._remove(self.path)
         os.replace(self._tmp, self.path)
+
+    def _name_storage_files(self) -> None:
+        """Give a ROS 2 folder's storage file the recording's name, not the temporary one.
+
+        rosbags names the file after the folder it writes (``.<name>.tmp-PID``); once the
+        folder is renamed that name would be left inside it, so the file is renamed and
+        ``metadata.yaml`` (``relative_file_paths``, ``files[].path``) follows.
+        """
+        meta_path = self._tmp / "metadata.yaml"
+        meta = yaml.safe_load(meta_path.read_text(encoding="utf-8"))
+        info = meta["rosbag2_bagfile_information"]
+        renames: dict[str, str] = {}
+        for old in info.get("relative_file_paths", []):
+            new = f"{self.path.name}{Path(old).suffix}"
+            os.replace(self._tmp / old, self._tmp / new)
+            renames[old] = new
+        info["relative_file_paths"] = [renames[f] for f in info.get("relative_file_paths", [])]
+        for entry in info.get("files") or []:
+            entry["path"] = renames.get(entry["path"], entry["path"])
+        meta_path.write_text(yaml.safe_dump(meta, sort_keys=False), encoding="utf-8")
 
     def _abort(self) -> None:
         try:
