@@ -415,6 +415,29 @@ def load_yaml(path: Path) -> dict[str, Any]:
     return data
 
 
+def load_paper(
+    method: str,
+    *,
+    mappings: Iterable[str] = (),
+    present: Iterable[str] = (),
+    path: Path | None = None,
+) -> dict[str, Any]:
+    """A paper's published numbers and claim thresholds (``configs/papers/<method>.yaml``).
+
+    ``mappings`` name keys that must hold a mapping, ``present`` keys that must exist;
+    anything else is a :class:`ConfigError` naming the file.
+    """
+    source = path or config_dir() / "papers" / f"{method}.yaml"
+    data = load_yaml(source)
+    for key in mappings:
+        if not isinstance(data.get(key), dict):
+            raise ConfigError(f"{source}: paper values need a mapping '{key}'")
+    for key in present:
+        if key not in data:
+            raise ConfigError(f"{source}: paper values need '{key}'")
+    return data
+
+
 def method_defaults(method: str) -> tuple[dict[str, Any], str]:
     """The raw config of a method: its paper's defaults file, else its pairing and gating."""
     from rgbd_eval.plugins import method_spec

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rgbd_eval.cache import DetectionCache, detection_key
-from rgbd_eval.config import RunConfig, build_config, config_dir, load_config, load_yaml
+from rgbd_eval.config import RunConfig, build_config, load_config, load_paper
 from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError, InputError, TaskError
@@ -67,12 +67,7 @@ def _detector(config: RunConfig) -> Basso2012DetectorConfig:
 
 def paper_values(path: Path | None = None) -> dict[str, Any]:
     """The published numbers and claim thresholds (``configs/papers/basso2012.yaml``)."""
-    source = path or config_dir() / "papers" / "basso2012.yaml"
-    data = load_yaml(source)
-    for key in ("tables", "figures", "claims"):
-        if not isinstance(data.get(key), dict):
-            raise ConfigError(f"{source}: paper values need a mapping '{key}'")
-    return data
+    return load_paper("basso2012", mappings=("tables", "figures", "claims"), path=path)
 
 
 @dataclass(frozen=True)

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rgbd_eval.config import build_config, config_dir, load_config, load_yaml
+from rgbd_eval.config import build_config, load_config, load_paper
 from rgbd_eval.errors import ConfigError, TaskError
 from rgbd_eval.io.groundtruth import GroundTruth
 from rgbd_eval.metrics import Counts, summarize, total
@@ -48,12 +48,8 @@ class Claim:
 
 def paper_values(path: Path | None = None) -> dict[str, Any]:
     """The seed's facts, the ablation and the claim thresholds (``configs/papers/cielniak2010.yaml``)."""
-    source = path or config_dir() / "papers" / "cielniak2010.yaml"
-    data = load_yaml(source)
-    for key in ("dataset", "scenarios", "ablations", "seeds", "classifier", "claims"):
-        if key not in data:
-            raise ConfigError(f"{source}: paper values need '{key}'")
-    return data
+    required = ("dataset", "scenarios", "ablations", "seeds", "classifier", "claims")
+    return load_paper("cielniak2010", present=required, path=path)
 
 
 def _overlaps(a: Box2D, b: Box2D) -> bool:

@@ -20,9 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-import yaml
-
-from rgbd_eval.config import config_dir, load_config
+from rgbd_eval.config import load_config, load_paper
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
@@ -255,10 +253,7 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
 
 def paper_values() -> dict[str, Any]:
     """The published numbers (``configs/papers/pinto2022.yaml``)."""
-    data = yaml.safe_load((config_dir() / "papers" / "pinto2022.yaml").read_text())
-    if not isinstance(data, dict):
-        raise ConfigError("configs/papers/pinto2022.yaml must hold a mapping")
-    return data
+    return load_paper("pinto2022")
 
 
 #: Columns of the tables: (title, summary key, paper key, scale, decimals).

@@ -19,8 +19,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
-from rgbd_eval.config import config_dir, load_config, load_yaml
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.config import load_config, load_paper
 from rgbd_eval.follow import FollowResult, FollowStep, follow
 from rgbd_eval.metrics import evaluate_sequence
 from rgbd_eval.metrics.clear import FrameEvents
@@ -31,12 +30,7 @@ from rgbd_eval.types import GroundTruthObject
 
 def paper_values() -> dict[str, Any]:
     """``configs/papers/satake2009.yaml``: the seed's facts and the claims' thresholds."""
-    source = config_dir() / "papers" / "satake2009.yaml"
-    data = load_yaml(source)
-    for key in ("timing", "fig8", "claims"):
-        if not isinstance(data.get(key), dict):
-            raise ConfigError(f"{source}: paper values need a mapping '{key}'")
-    return data
+    return load_paper("satake2009", mappings=("timing", "fig8", "claims"))
 
 
 @dataclass(frozen=True)
