@@ -563,37 +563,19 @@ def _other_command_cases() -> list[Case]:
     def run_sidecar(root: Path) -> list[str]:
         return ["run", str(with_bad_sidecar(root)), "--out", str(root / "out")]
 
+    def two_point_sweep(rec: Path, root: Path) -> list[str]:
+        """A sweep of min_confidence over -1 and 0 on ``rec``, two jobs."""
+        grid = ["sweep", "tracker.min_confidence", "-1", "0", "--dataset", str(rec)]
+        return [*grid, "--jobs", "2", "--out", str(root / "out")]
+
     def sweep_sidecar(root: Path) -> list[str]:
-        rec = with_bad_sidecar(root)
-        return [
-            "sweep",
-            "tracker.min_confidence",
-            "-1",
-            "0",
-            "--dataset",
-            str(rec),
-            "--jobs",
-            "2",
-            "--out",
-            str(root / "out"),
-        ]
+        return two_point_sweep(with_bad_sidecar(root), root)
 
     def sweep_corrupt(root: Path) -> list[str]:
         rec = root / "flip.mcap"
         write_recording(rec, "mcap", Spec(n=FRAMES))
         flip_byte(rec, mcap_chunk_data_offset(rec))
-        return [
-            "sweep",
-            "tracker.min_confidence",
-            "-1",
-            "0",
-            "--dataset",
-            str(rec),
-            "--jobs",
-            "2",
-            "--out",
-            str(root / "out"),
-        ]
+        return two_point_sweep(rec, root)
 
     def sweep_nan(root: Path) -> list[str]:
         rec = good_recording(root)
