@@ -717,62 +717,38 @@ def _score_cases() -> list[Case]:
 
 
 def _model_and_cache_cases() -> list[Case]:
-    def not_a_model(root: Path) -> list[str]:
-        (root / "model.onnx").write_bytes(b"not an onnx model\n" * 10)
-        return [
-            "run",
-            str(good_recording(root)),
-            "--method",
-            "pinto2022",
-            "--set",
-            "detector.person.backend=onnx",
-            "--set",
-            f"detector.person.model={root / 'model.onnx'}",
-            "--out",
-            str(root / "out"),
-        ]
+    def run_naming_file(
+        name: str, data: bytes | None, method: str, *overrides: str
+    ) -> Callable[[Path], list[str]]:
+        """``run --method method`` with ``--set`` overrides naming ``root/name`` as ``{path}``:
+        a file holding ``data``, or a named pipe when ``data`` is None."""
+
+        def build(root: Path) -> list[str]:
+            path = root / name
+            if data is None:
+                os.mkfifo(path)
+            else:
+                path.write_bytes(data)
+            sets = [arg for o in overrides for arg in ("--set", o.format(path=path))]
+            head = ["run", str(good_recording(root)), "--method", method]
+            return [*head, *sets, "--out", str(root / "out")]
+
+        return build
+
+    not_a_model = run_naming_file(
+        "model.onnx",
+        b"not an onnx model\n" * 10,
+        "pinto2022",
+        "detector.person.backend=onnx",
+        "detector.person.model={path}",
+    )
 
     def det_txt(data: bytes | None) -> Callable[[Path], list[str]]:
-        def build(root: Path) -> list[str]:
-            det = root / "det.txt"
-            if data is None:
-                os.mkfifo(det)
-            else:
-                det.write_bytes(data)
-            return [
-                "run",
-                str(good_recording(root)),
-                "--method",
-                "pinto2022",
-                "--set",
-                "detector.person.backend=recorded",
-                "--set",
-                f"detector.person.source={det}",
-                "--out",
-                str(root / "out"),
-            ]
-
-        return build
+        recorded = ("detector.person.backend=recorded", "detector.person.source={path}")
+        return run_naming_file("det.txt", data, "pinto2022", *recorded)
 
     def calibration(data: bytes | None) -> Callable[[Path], list[str]]:
-        def build(root: Path) -> list[str]:
-            calib = root / "calib.yaml"
-            if data is None:
-                os.mkfifo(calib)
-            else:
-                calib.write_bytes(data)
-            return [
-                "run",
-                str(good_recording(root)),
-                "--method",
-                "dmtbs",
-                "--set",
-                f"detector.calibration={calib}",
-                "--out",
-                str(root / "out"),
-            ]
-
-        return build
+        return run_naming_file("calib.yaml", data, "dmtbs", "detector.calibration={path}")
 
     def reproduce_into_file(option: str) -> Callable[[Path], list[str]]:
         def build(root: Path) -> list[str]:
