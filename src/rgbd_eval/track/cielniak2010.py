@@ -15,20 +15,26 @@ Per frame:
    our addition), minus the distance of the colour moments of its head, torso and legs
    to the person's adaptive colour model over ``colour_scale`` (section 4; the colour
    image is aligned by the affine map below), with the interaction ``rho`` towards the
-   other filters' estimates. A filter behind another one (section 6: pairwise
+   other filters' estimates. The moments are of the person's own pixels: the warm pixels
+   of the thermal image mapped onto the colour image (``colour_mask``). The colour term is
+   weighted by the person's colour reliability, its contrast to the image's mean colour
+   against the image noise (:func:`rgbd_eval.track.colour_moments.reliability`): about 1
+   in the light, about 0 in the dark, where colour would otherwise mislead. A filter behind another one (section 6: pairwise
    :func:`rgbd_eval.track.occlusion.order`, overlap of the boxes at least
    ``occlusion_overlap``) coasts on its motion model, and neither penalises nor is
    penalised by the others, for at most ``max_occluded_frames``.
 2. A filter whose estimate scores below ``stop_score`` for ``lost_frames`` frames in a
    row, or whose centre leaves the image, is deleted; its colour model is remembered
    ``reid_memory_frames`` for re-identification (section 6). The colour model of a filter
-   seen clearly (score at least ``start_score``, no overlap) adapts at rate ``colour_alpha``.
+   seen clearly (score at least ``start_score``, its box overlapping no other filter's)
+   adapts at rate ``colour_alpha``.
 3. The sequential detector proposes person-shaped warm regions
    (:mod:`rgbd_eval.track.warm_regions`) away from the tracked persons; a proposal that
    scores at least ``start_score`` and implies a standing height within the prior's
    range, and is seen again (IoU >= 0.3) in ``confirm_frames`` consecutive frames,
-   starts a filter, with the id of a remembered person whose colour moments lie within
-   ``reid_distance``, else a new one.
+   starts a filter, with the id of the nearest remembered person whose colour moments lie
+   within ``reid_distance``, when the new person's colour reliability is at least
+   ``reid_min_reliability``; else a new one.
 
 Boxes are mapped from the thermal to the colour image, where the ground truth lives, by
 the affine transform of parallel cameras at a nominal depth (seed 004, section 4.1: the
