@@ -119,7 +119,7 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     occlusion_overlap: float = Field(0.3, gt=0.0, le=1.0, description="over the smaller box")
     max_occluded_frames: int = Field(60, ge=1, description="an occluded filter coasts this long")
     colour: bool = Field(True, description="section 4: colour moments in the likelihood")
-    colour_scale: float = Field(20.0, gt=0.0, description="moment distance per log-likelihood")
+    colour_scale: float = Field(10.0, gt=0.0, description="moment distance per log-likelihood")
     colour_alpha: float = Field(0.05, ge=0.0, le=1.0, description="adaptive update rate")
     colour_stride: int = Field(2, ge=1, le=16, description="colour image subsampling")
     colour_noise_factor: float = Field(
