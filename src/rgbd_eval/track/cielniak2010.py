@@ -19,7 +19,8 @@ Per frame:
    of the thermal image mapped onto the colour image (``colour_mask``). The colour term is
    weighted by the person's colour reliability, its contrast to the image's mean colour
    against the image noise (:func:`rgbd_eval.track.colour_moments.reliability`): about 1
-   in the light, about 0 in the dark, where colour would otherwise mislead. A filter behind another one (section 6: pairwise
+   in the light, about 0 in the dark, where colour would otherwise mislead. A filter
+   behind another one (section 6: pairwise
    :func:`rgbd_eval.track.occlusion.order`, overlap of the boxes at least
    ``occlusion_overlap``) coasts on its motion model, and neither penalises nor is
    penalised by the others, for at most ``max_occluded_frames``.
