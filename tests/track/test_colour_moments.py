@@ -178,3 +178,14 @@ def test_model_contrast_to_the_background() -> None:
     moments = np.array([[[110.0], [5.0], [0.0]], [[70.0], [5.0], [0.0]], [[np.nan]] * 3])
     assert ColourModel(moments).contrast(np.array([100.0])) == pytest.approx(20.0)
     assert ColourModel(np.full((1, 3, 1), np.nan)).contrast(np.array([100.0])) == 0.0
+
+
+def test_eight_bit_and_float_integrals_are_the_same_numbers() -> None:
+    # the uint8 path (integral2 and a float32 cube) sums the same integers as float64
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (30, 40, 3)).astype(np.uint8)
+    mask = rng.random((30, 40)) < 0.5
+    for m in (None, mask):
+        a, b = IntegralMoments.of(image, m), IntegralMoments.of(image.astype(np.float64), m)
+        for x, y in ((a.s1, b.s1), (a.s2, b.s2), (a.s3, b.s3)):
+            np.testing.assert_array_equal(x, y)

@@ -264,7 +264,7 @@ class Cielniak2010Tracker:
         self.integral = None
         if self.cfg.colour and colour is not None and colour.image.ndim == 3:
             k = self.cfg.colour_stride
-            image = colour.image[::k, ::k]
+            image = np.ascontiguousarray(colour.image[::k, ::k])
             mask = None
             if self.cfg.colour_mask and self.affine is not None:
                 mask = self.affine.warp(self._warm_mask(temp), image.shape[:2], k)

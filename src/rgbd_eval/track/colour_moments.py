@@ -54,17 +54,16 @@ class IntegralMoments:
     ) -> IntegralMoments:
         """From an ``HxW`` or ``HxWxC`` image (any numeric dtype), over the pixels of ``mask``
         (``HxW``) when given: a box with fewer than ``min_count`` of them is not measured."""
-        img = np.asarray(image, dtype=np.float64)
-        if img.ndim == 2:
-            img = img[..., None]
+        raw = np.asarray(image)
+        img = raw[..., None] if raw.ndim == 2 else raw
         if img.ndim != 3:
-            raise ValueError(f"image shape {image.shape} must be HxW or HxWxC")
+            raise ValueError(f"image shape {raw.shape} must be HxW or HxWxC")
         if mask is not None and mask.shape != img.shape[:2]:
             raise ValueError(f"mask shape {mask.shape} differs from image shape {img.shape[:2]}")
         if min_count < 1:
             raise ValueError(f"min_count={min_count} must be at least 1")
 
-        def integral(a: F64) -> F64:
+        def integral(a: NDArray[np.generic]) -> F64:
             # OpenCV's integral (4x faster than two cumsums); sums of 8-bit powers stay
             # below 2^53 for images up to 2^12 x 2^12, so both are exact and equal
             out = cv2.integral(np.ascontiguousarray(a), sdepth=cv2.CV_64F)
@@ -72,9 +71,22 @@ class IntegralMoments:
 
         count = None
         if mask is not None:
-            m = mask.astype(np.float64)[..., None]
-            img = img * m
-            count = integral(m)
+            count = integral(mask.astype(np.uint8))
+            img = img * mask[..., None].astype(img.dtype)
+        if img.dtype == np.uint8:
+            # 8-bit: p and p^2 in one pass from the bytes, p^3 <= 255^3 < 2^24 exact in
+            # float32; the same integers as the float64 path, a third of its time
+            s1, s2 = cv2.integral2(np.ascontiguousarray(img), sdepth=cv2.CV_64F, sqdepth=cv2.CV_64F)
+            shape = (img.shape[0] + 1, img.shape[1] + 1, -1)
+            f = img.astype(np.float32)
+            return IntegralMoments(
+                np.asarray(s1, dtype=np.float64).reshape(shape),
+                np.asarray(s2, dtype=np.float64).reshape(shape),
+                integral(f * f * f),
+                count,
+                min_count if count is not None else 1,
+            )
+        img = img.astype(np.float64)
         sq = img * img
         return IntegralMoments(
             integral(img),
