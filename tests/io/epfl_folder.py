@@ -111,5 +111,5 @@ def colour(n: int) -> NDArray[np.uint8]:
     image = np.zeros((cam.height, cam.width, 3), dtype=np.uint8)
     image[..., 0] = (np.arange(cam.width) % 256).astype(np.uint8)[None, :]
     image[..., 1] = (np.arange(cam.height) % 256).astype(np.uint8)[:, None]
-    image[..., 2] = 10 * n
+    image[..., 2] = (10 * n) % 256
     return image
