@@ -271,19 +271,25 @@ def test_an_annotated_frame_without_its_image_is_refused_and_nothing_is_written(
     for kind in ("rgb", "depth"):
         (folder / f"{kind}000001.png").unlink()
     out = tmp_path / "lab.mcap"
-    with pytest.raises(GroundTruthError, match=r"frame 1 is annotated but depth000001\.png"):
-        import_sequence(
-            scan_sequence(folder), out, annotations=folder.parent / "ground_truth_image_plane.yaml"
-        )
+    annotations = folder.parent / "ground_truth_image_plane.yaml"
+    for max_frames in (None, 1):  # checked against the whole folder, converted or not
+        with pytest.raises(GroundTruthError, match=r"frame 1 is annotated but depth000001\.png"):
+            import_sequence(
+                scan_sequence(folder), out, annotations=annotations, max_frames=max_frames
+            )
     assert not out.exists() and not (tmp_path / "lab.gt.csv").exists()
-    # Converting only the first frame leaves the later annotations out of range: accepted.
+
+
+def test_max_frames_converts_a_prefix_and_counts_its_annotations(tmp_path: Path) -> None:
+    folder = write_sequence(tmp_path, [(4.0, 0.0), None, (4.0, 0.2)])
     summary = import_sequence(
         scan_sequence(folder),
-        out,
+        tmp_path / "lab.mcap",
         annotations=folder.parent / "ground_truth_image_plane.yaml",
-        max_frames=1,
+        max_frames=2,
     )
-    assert (summary.frames, summary.annotated_frames) == (1, 1)
+    # Frames 0 and 1 are written; of the annotated frames 0 and 2 only frame 0 is among them.
+    assert (summary.frames, summary.annotated_frames, summary.boxes) == (2, 1, 1)
 
 
 def test_a_bad_image_midway_leaves_no_half_written_recording(tmp_path: Path) -> None:

@@ -146,7 +146,11 @@ def scan_sequence(folder: Path) -> EpflSequence:
         raise InputError(folder, "not a folder; expected an EPFL-RGBD sequence folder")
     depth: dict[int, Path] = {}
     rgb: dict[int, Path] = {}
-    for path in folder.iterdir():
+    try:
+        names = sorted(folder.iterdir())
+    except OSError as err:
+        raise InputError(folder, f"cannot list the folder ({err.strerror})") from err
+    for path in names:
         match = _IMAGE_NAME.match(path.name)
         if match is None:
             continue
@@ -354,10 +358,9 @@ def frame_stamp_ns(start_ns: int, number: int, fps: float) -> int:
 def _check_annotations(
     boxes: Mapping[int, Mapping[int, Box2D]], frames: tuple[EpflFrame, ...], source: Path
 ) -> None:
-    """Every annotated frame within the converted range must have an image."""
+    """Every annotated frame must have its image in the folder (converted or not)."""
     numbers = {f.number for f in frames}
-    last = frames[-1].number
-    orphans = sorted(n for n in boxes if n <= last and n not in numbers)
+    orphans = sorted(n for n in boxes if n not in numbers)
     if orphans:
         raise GroundTruthError(
             source,
@@ -389,6 +392,26 @@ def _frames(
         yield frame, depth, rgb
 
 
+def _people(
+    index: int,
+    stamp_ns: int,
+    boxes: Mapping[int, Box2D],
+    depth: NDArray[np.float32],
+    camera: CameraModel,
+    world_T_optical: Pose | None,
+) -> list[GroundTruthObject]:
+    """One frame's ground truth: each box, with its derived position when the floor is known."""
+    people = []
+    for person, box in sorted(boxes.items()):
+        world = (
+            ground_position(depth, box, camera, world_T_optical)
+            if world_T_optical is not None
+            else None
+        )
+        people.append(GroundTruthObject(index, stamp_ns, person, box, world))
+    return people
+
+
 def import_sequence(
     sequence: EpflSequence,
     out: Path,
@@ -414,12 +437,12 @@ def import_sequence(
     if max_frames is not None and max_frames < 1:
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     camera = replace(camera, frame_id=CAMERA_FRAME)
-    frames = sequence.frames[:max_frames] if max_frames is not None else sequence.frames
-    sequence = EpflSequence(sequence.folder, frames)
     boxes: dict[int, dict[int, Box2D]] = {}
     if annotations is not None:
         boxes = read_image_plane_annotations(annotations, sequence.tag)
-        _check_annotations(boxes, frames, annotations)
+        _check_annotations(boxes, sequence.frames, annotations)
+    frames = sequence.frames[:max_frames] if max_frames is not None else sequence.frames
+    sequence = EpflSequence(sequence.folder, frames)
     start = start_stamp_ns(sequence.tag)
     out = Path(out)
     csv_path = out.with_name(f"{out.stem}.gt.csv") if annotations is not None else None
@@ -429,35 +452,33 @@ def import_sequence(
         writer = RecordingWriter(out, options=StreamOptions(depth_encoding="16UC1"), overwrite=True)
     except (IsADirectoryError, ValueError) as err:
         raise OutputError(out, str(err)) from err
-    with writer as w:
-        if world_T_optical is not None:
-            w.write_static_transform(
-                frame_stamp_ns(start, frames[0].number, fps),
-                WORLD_FRAME,
-                CAMERA_FRAME,
-                world_T_optical,
-            )
-        for index, (frame, depth, rgb) in enumerate(_frames(sequence, camera, with_rgb)):
-            stamp = frame_stamp_ns(start, frame.number, fps)
-            if rgb is not None:
-                w.write_rgb(stamp, rgb, camera)
-            w.write_depth(stamp, depth, camera)
-            if annotations is not None:
-                people = []
-                for person, box in sorted(boxes.get(frame.number, {}).items()):
-                    world = (
-                        ground_position(depth, box, camera, world_T_optical)
-                        if world_T_optical is not None
-                        else None
+    try:
+        with writer as w:
+            if world_T_optical is not None:
+                w.write_static_transform(
+                    frame_stamp_ns(start, frames[0].number, fps),
+                    WORLD_FRAME,
+                    CAMERA_FRAME,
+                    world_T_optical,
+                )
+            for index, (frame, depth, rgb) in enumerate(_frames(sequence, camera, with_rgb)):
+                stamp = frame_stamp_ns(start, frame.number, fps)
+                if rgb is not None:
+                    w.write_rgb(stamp, rgb, camera)
+                w.write_depth(stamp, depth, camera)
+                if annotations is not None:
+                    people = _people(
+                        index, stamp, boxes.get(frame.number, {}), depth, camera, world_T_optical
                     )
-                    positions += world is not None
-                    people.append(GroundTruthObject(index, stamp, person, box, world))
-                w.write_ground_truth(stamp, WORLD_FRAME, people)
-                objects.extend(people)
-            if progress is not None:
-                progress(index + 1, len(frames))
-    if csv_path is not None:
-        write_csv(csv_path, objects)
+                    positions += sum(p.world_xyz is not None for p in people)
+                    w.write_ground_truth(stamp, WORLD_FRAME, people)
+                    objects.extend(people)
+                if progress is not None:
+                    progress(index + 1, len(frames))
+        if csv_path is not None:
+            write_csv(csv_path, objects)
+    except OSError as err:  # disk full, permissions: the writer removed its temp file
+        raise OutputError(out, f"cannot write ({err.strerror or err})") from err
     last = frames[-1].number
     return ImportSummary(
         recording=out,
