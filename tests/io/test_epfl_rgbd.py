@@ -69,6 +69,10 @@ def test_annotations_read_per_sequence_frame_and_person(tmp_path: Path) -> None:
         36: {1: Box2D(101.5, 50, 40, 120)},
     }
     assert read_image_plane_annotations(path, TAG) == {40: {2: Box2D(10, 20, 30, 40)}}
+    # Unquoted, YAML 1.1 reads 20141008_141323_00 as the integer 2014100814132300 (above);
+    # the published file quotes it.
+    quoted = _yaml(tmp_path, "'20141008_141323_00': {7: {4: [1, 2, 3, 4]}}\n")
+    assert read_image_plane_annotations(quoted, "20141008_141323_00") == {7: {4: Box2D(1, 2, 3, 4)}}
 
 
 @pytest.mark.parametrize(
