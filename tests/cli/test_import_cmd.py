@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -29,6 +30,11 @@ def test_floor_from_the_first_frame_places_the_camera_and_the_people(tmp_path: P
     assert (
         "2 frames" in output and "1 boxes in 1 annotated frames, 1 with a world position" in output
     )
+    # RANSAC on the mm-rounded floor: height to 5 mm, pitch to a few tenths of a degree.
+    found = re.search(r"camera ([\d.]+) m above the floor, looking ([\d.]+) deg down", output)
+    assert found is not None, output
+    assert float(found[1]) == pytest.approx(2.0, abs=0.005)
+    assert float(found[2]) == pytest.approx(10.0, abs=0.3)
     frame = next(iter(open_recording(tmp_path / "lab.mcap").frames()))
     # RANSAC on the floor recovers the camera height (to the depth's mm rounding).
     assert frame.camera_pose.translation[2] == pytest.approx(2.0, abs=0.005)

@@ -81,6 +81,13 @@ def _camera_pose(floor: str, first_depth: Path, camera: CameraModel) -> Pose | N
         raise ConfigError(f"--floor {floor!r}: {err}") from err
 
 
+def _height_and_pitch(world_T_optical: Pose) -> tuple[float, float]:
+    """The camera's height above the floor (m) and how far its axis points down (deg)."""
+    axis = world_T_optical.rotation_matrix()[:, 2]  # the optical z (viewing) axis in the world
+    down = math.degrees(math.asin(max(-1.0, min(1.0, -float(axis[2])))))
+    return float(world_T_optical.translation[2]), down
+
+
 @handle_errors
 def import_(
     fmt: Annotated[str, typer.Argument(metavar="FORMAT", help="dataset layout: epfl-rgbd")],
@@ -156,3 +163,6 @@ def import_(
         else ""
     )
     console.print(f"{summary.recording} ({summary.frames} frames){gt}")
+    if world_T_optical is not None:
+        height, down = _height_and_pitch(world_T_optical)
+        console.print(f"camera {height:.2f} m above the floor, looking {down:.1f} deg down")
