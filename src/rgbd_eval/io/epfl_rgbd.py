@@ -79,7 +79,8 @@ EPFL_KINECT2 = CameraModel(
     distortion=(0.0878958787229031, -0.2702768047075843, 0.0, 0.0, 0.09939543207758726),
     frame_id=CAMERA_FRAME,
 )
-#: Kinect v2 frame rate (seed 003, 4.3: "512x424 ... at 30 Hz"); the folders carry no stamps.
+#: The Kinect v2's nominal depth rate (issue 14 models seed 003 4.3's Kinect for Xbox One as
+#: 512x424 at 30 Hz; the seed text is cut after "512"). The folders carry no stamps.
 DEFAULT_FPS = 30.0
 #: Annotation files are data, not configuration: allow far more values than a config YAML.
 MAX_ANNOTATION_VALUES = 20_000_000
