@@ -19,7 +19,7 @@ same way by at least two independent users' code (docs/datasets.md lists the sea
   ``test/pcl_people_detector/Dataset-Simulation/dataset_pcl_people_detection.cpp`` (reads
   ``rgb%06d.png``/``depth%06d.png`` of ``epfl_lab/20140804_160621_00``, 512x424, depth / 1000
   as metres, 0 skipped, colour read at the depth pixel); grupesh/social-distancing-monitoring
-  ``ipm.py``/``analyze_distance.py`` (``depth*.png`` read unchanged as a depth map).
+  ``ipm.py`` (``rgb%06d.png``; ``depth*.png`` read unchanged as depth).
 - Intrinsics fx = fy = 365.8046, cx = 254.3151, cy = 206.9851 and plumb-bob distortion
   (0.0879, -0.2703, 0, 0, 0.0994): cimat_sort_rgbd (same file, "Camera matrix of dataset
   epfl_lab"), grupesh/social-distancing-monitoring ``calibration/calibration.yaml`` (K and dist
