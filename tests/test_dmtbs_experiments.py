@@ -46,7 +46,8 @@ def _frames(n: int) -> list[TofFrame]:
 
 
 def test_run_frames_scores_after_the_initialisation() -> None:
-    det = DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2))
+    # The 6x6-pixel box top is ~0.026 m^2 of surface, below the default smallest blob.
+    det = DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2), min_blob_area_m2=0.0)
     run = run_frames(_frames(8), ["a"], det, DmtbsTrackerConfig(confirm_hits=3))
     row = run.row()
     # Frames 2..7 are scored (6 instances); the track is confirmed at its third hit (frame 4),
