@@ -64,7 +64,7 @@ def _process_cpu(client: Any, in_process: bool) -> float:
     """CPU seconds of the client process, plus the worker processes when they are others."""
     if in_process:
         return _cpu_here()
-    return _cpu_here() + sum(client.run(_worker_cpu).values())
+    return _cpu_here() + float(sum(client.run(_worker_cpu).values()))
 
 
 def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
@@ -86,6 +86,18 @@ def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
         "makespan_s": round(makespan, 3),
         "utilisation": round(utilisation, 3),
     }
+
+
+def _timeline(records: list[dict[str, Any]]) -> list[tuple[str, str, float, float]]:
+    """``(task, worker, start, stop)`` of every compute span, seconds from the first start."""
+    spans = [
+        (str(rec["key"]).rsplit("-", 1)[0], str(rec["worker"]), s["start"], s["stop"])
+        for rec in records
+        for s in rec.get("startstops", ())
+        if s.get("action") == "compute"
+    ]
+    t0 = min((s[2] for s in spans), default=0.0)
+    return sorted((k, w[-5:], round(a - t0, 3), round(b - t0, 3)) for k, w, a, b in spans)
 
 
 async def _heartbeat(dask_worker: Any) -> None:
@@ -127,32 +139,60 @@ def _schedule(tasks: list[tuple[str, float, list[str]]], workers: int) -> float:
     return max(done.values())
 
 
-def _sweep_graph(
-    cpu: dict[str, float], counts: dict[str, int]
-) -> list[tuple[str, float, list[str]]]:
-    """The task graph ``run_sweep`` submits for one recording, each task taking its prefix's
-    measured thread CPU seconds divided evenly among the prefix's tasks."""
+def _task_costs(records: list[dict[str, Any]], cpu: dict[str, float]) -> dict[str, float]:
+    """Thread CPU seconds of each task (by its name, ``prefix`` or ``prefix-index``): its
+    prefix's measured CPU seconds shared among the prefix's tasks in proportion to their
+    compute time in the task stream (chunks of unequal length cost unequal time)."""
+    from dask.utils import key_split
 
-    def each(prefix: str) -> float:
-        return cpu.get(prefix, 0.0) / max(1, counts.get(prefix, 1))
+    wall: dict[str, float] = {}
+    for rec in records:
+        key = str(rec["key"])
+        prefix = key_split(key).lstrip("_")
+        parts = key.split("-")
+        name = f"{prefix}-{parts[1]}" if len(parts) == 3 and parts[1].isdigit() else prefix
+        spans = [s for s in rec.get("startstops", ()) if s.get("action") == "compute"]
+        wall[name] = sum(s["stop"] - s["start"] for s in spans)
+    total: dict[str, float] = {}
+    for name, w in wall.items():
+        prefix = name.split("-")[0]
+        total[prefix] = total.get(prefix, 0.0) + w
+    out = {}
+    for name, w in wall.items():
+        prefix = name.split("-")[0]
+        count = sum(n.split("-")[0] == prefix for n in wall)
+        share = w / total[prefix] if total[prefix] > 0 else 1.0 / count
+        out[name] = cpu.get(prefix, 0.0) * share
+    return out
 
-    graph = [("prepare", each("prepare"), [])]
-    chunks = counts.get("detect_chunk", 0)
+
+def _sweep_graph(costs: dict[str, float]) -> list[tuple[str, float, list[str]]]:
+    """The task graph ``run_sweep`` submits for one recording, in submission order, each task
+    with its thread CPU seconds (:func:`_task_costs`)."""
+
+    def named(prefix: str) -> list[str]:
+        return sorted(
+            (n for n in costs if n.split("-")[0] == prefix), key=lambda n: int(n[len(prefix) + 1 :])
+        )
+
+    graph: list[tuple[str, float, list[str]]] = [("prepare", costs["prepare"], [])]
     last = "prepare"
+    chunks = named("detect_chunk")
     if chunks:
-        state = None
-        for k in range(chunks - 1):
-            graph.append(
-                (f"advance{k}", each("advance"), ["prepare"] + ([state] if state else []))
-            )
-            state = f"advance{k}"
-        for k in range(chunks):
-            deps = ["prepare"] + ([f"advance{k - 1}"] if k else [])
-            graph.append((f"chunk{k}", each("detect_chunk"), deps))
-        graph.append(("join", each("join"), ["prepare"] + [f"chunk{k}" for k in range(chunks)]))
+        advances = named("advance")
+        for k, name in enumerate(advances):
+            graph.append((name, costs[name], ["prepare"] + advances[k - 1 : k] * (k > 0)))
+        for k, name in enumerate(chunks):
+            graph.append((name, costs[name], ["prepare"] + advances[k - 1 : k] * (k > 0)))
+        graph.append(("join", costs["join"], ["prepare", *chunks]))
         last = "join"
-    graph.append(("brief", each("brief"), [last]))
-    graph += [(f"track{i}", each("track"), [last]) for i in range(counts.get("track", 0))]
+    graph.append(("brief", costs["brief"], [last]))
+    tracks = named("track")
+    graph += [(name, costs[name], [last]) for name in tracks]
+    graph += [
+        (f"score-{name.split('-')[1]}", costs[f"score-{name.split('-')[1]}"], [last, name])
+        for name in tracks
+    ]
     return graph
 
 
@@ -177,7 +217,8 @@ def _one_run(
     for rec in stream.data:
         prefix = key_split(rec["key"]).lstrip("_")
         counts[prefix] = counts.get(prefix, 0) + 1
-    graph = _sweep_graph(task_cpu, counts)
+    costs = _task_costs(stream.data, task_cpu)
+    graph = _sweep_graph(costs)
     if result.failures:
         raise SystemExit(f"sweep failed: {result.failures[0].error}")
     return {
@@ -191,6 +232,8 @@ def _one_run(
         "records": [(r.point, r.counts) for r in result.records],
         "task_cpu_s": task_cpu,
         "task_counts": counts,
+        "task_cpu_each_s": {k: round(v, 3) for k, v in costs.items()},
+        "timeline": _timeline(stream.data),
         # Idle-machine makespans of this run's graph from its tasks' CPU seconds.
         "estimate_1_s": round(_schedule(graph, 1), 3),
         "estimate_2_s": round(_schedule(graph, 2), 3),
