@@ -9,11 +9,13 @@ of every worker process, the load average before and after, and from the Dask ta
 stream each worker's busy seconds and the makespan; then the medians and ratios.
 
 The wall-clock ratio is what an idle machine shows. On a shared one it is noise,
-so the script also gives an estimate that the load does not move: the thread CPU
-seconds of every task (Dask's fine performance metrics, per task prefix) placed on
-the task graph ``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run
-and on two for ``local:2``'s: the makespans an idle machine would give, without
-transfer, scheduling or start-up costs.
+so the script also gives an estimate that the load moves less: the thread CPU
+seconds of every task (each task function records its own, :func:`_instrument`; the
+per-prefix sums are Dask's fine performance metrics) placed on the task graph
+``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run and on two
+for ``local:2``'s: the makespans an idle machine would give, without transfer,
+scheduling or start-up costs. The JSON holds each run's per-task CPU seconds and
+its timeline (task, worker, start, stop).
 
     .venv/bin/python bench/dask_scaling.py               # moving_complex, 3 reps: ~2.5 min idle
     .venv/bin/python bench/dask_scaling.py --json runs/bench/dask_scaling.json
@@ -37,6 +39,7 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
+import rgbd_eval.cli  # noqa: F401  # first: the CLI's one-thread environment
 from rgbd_eval import datasets
 from rgbd_eval.config import load_config
 from rgbd_eval.engine import ClusterSpec, connect
@@ -139,30 +142,50 @@ def _schedule(tasks: list[tuple[str, float, list[str]]], workers: int) -> float:
     return max(done.values())
 
 
-def _task_costs(records: list[dict[str, Any]], cpu: dict[str, float]) -> dict[str, float]:
-    """Thread CPU seconds of each task (by its name, ``prefix`` or ``prefix-index``): its
-    prefix's measured CPU seconds shared among the prefix's tasks in proportion to their
-    compute time in the task stream (chunks of unequal length cost unequal time)."""
+#: The sweep's task functions (rgbd_eval.sweep), each timed by :func:`_instrument`.
+TASKS = ("_prepare", "_advance", "_detect_chunk", "_join", "_brief", "_track", "_score")
+
+
+def _instrument() -> None:
+    """Make the sweep's task functions in this process record their thread CPU seconds in
+    their task's metadata, which the task stream carries (run on every worker)."""
+    import functools
+
+    from distributed import get_worker
+
+    from rgbd_eval import sweep
+
+    def timed(func: Any) -> Any:
+        @functools.wraps(func)
+        def run(*args: Any) -> Any:
+            start = time.thread_time()
+            try:
+                return func(*args)
+            finally:
+                worker = get_worker()
+                task = worker.state.tasks.get(worker.get_current_task())
+                if task is not None:
+                    task.metadata["thread_cpu_s"] = time.thread_time() - start
+
+        return run
+
+    for name in TASKS:
+        func = getattr(sweep, name)
+        if not hasattr(func, "__wrapped__"):
+            setattr(sweep, name, timed(func))
+
+
+def _task_costs(records: list[dict[str, Any]]) -> dict[str, float]:
+    """Thread CPU seconds of each task, by its name (``prefix`` or ``prefix-index``)."""
     from dask.utils import key_split
 
-    wall: dict[str, float] = {}
+    out = {}
     for rec in records:
         key = str(rec["key"])
         prefix = key_split(key).lstrip("_")
         parts = key.split("-")
         name = f"{prefix}-{parts[1]}" if len(parts) == 3 and parts[1].isdigit() else prefix
-        spans = [s for s in rec.get("startstops", ()) if s.get("action") == "compute"]
-        wall[name] = sum(s["stop"] - s["start"] for s in spans)
-    total: dict[str, float] = {}
-    for name, w in wall.items():
-        prefix = name.split("-")[0]
-        total[prefix] = total.get(prefix, 0.0) + w
-    out = {}
-    for name, w in wall.items():
-        prefix = name.split("-")[0]
-        count = sum(n.split("-")[0] == prefix for n in wall)
-        share = w / total[prefix] if total[prefix] > 0 else 1.0 / count
-        out[name] = cpu.get(prefix, 0.0) * share
+        out[name] = float((rec.get("metadata") or {}).get("thread_cpu_s", 0.0))
     return out
 
 
@@ -217,7 +240,7 @@ def _one_run(
     for rec in stream.data:
         prefix = key_split(rec["key"]).lstrip("_")
         counts[prefix] = counts.get(prefix, 0) + 1
-    costs = _task_costs(stream.data, task_cpu)
+    costs = _task_costs(stream.data)
     graph = _sweep_graph(costs)
     if result.failures:
         raise SystemExit(f"sweep failed: {result.failures[0].error}")
@@ -277,6 +300,7 @@ def main() -> int:
                 t0 = time.perf_counter()
                 clients[n] = stack.enter_context(connect(ClusterSpec(None, n)))
                 startup[n] = round(time.perf_counter() - t0, 3)
+                clients[n].run(_instrument)
                 print(f"local:{n} started in {startup[n]:.2f} s (wall)")
             reference = None
             for rep in range(args.reps):
