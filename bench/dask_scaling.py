@@ -91,16 +91,25 @@ def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
     }
 
 
-def _timeline(records: list[dict[str, Any]]) -> list[tuple[str, str, float, float]]:
-    """``(task, worker, start, stop)`` of every compute span, seconds from the first start."""
+def _timeline(records: list[dict[str, Any]]) -> list[tuple[str, str, str, float, float]]:
+    """``(task, action, worker, start, stop)`` of every span of the task stream (compute, and
+    transfer of the task's inputs to its worker), seconds from the first start."""
     spans = [
-        (str(rec["key"]).rsplit("-", 1)[0], str(rec["worker"]), s["start"], s["stop"])
+        (
+            str(rec["key"]).rsplit("-", 1)[0],
+            str(s["action"]),
+            str(rec["worker"]),
+            s["start"],
+            s["stop"],
+        )
         for rec in records
         for s in rec.get("startstops", ())
-        if s.get("action") == "compute"
     ]
-    t0 = min((s[2] for s in spans), default=0.0)
-    return sorted((k, w[-5:], round(a - t0, 3), round(b - t0, 3)) for k, w, a, b in spans)
+    t0 = min((s[3] for s in spans), default=0.0)
+    return sorted(
+        ((k, a, w[-5:], round(b - t0, 3), round(c - t0, 3)) for k, a, w, b, c in spans),
+        key=lambda span: span[3],
+    )
 
 
 async def _heartbeat(dask_worker: Any) -> None:

@@ -27,10 +27,16 @@ class RecordingClient:
 
     calls: list[tuple[Submitted, dict[str, Any]]] = field(default_factory=list)
 
+    scattered: list[tuple[Any, dict[str, Any]]] = field(default_factory=list)
+
     def submit(self, func: Any, *args: Any, key: str, **options: Any) -> Submitted:
         future = Submitted(func, args, key)
         self.calls.append((future, options))
         return future
+
+    def scatter(self, data: Any, **options: Any) -> Submitted:
+        self.scattered.append((data, options))
+        return Submitted(self.scatter, (data,), f"scattered-{len(self.scattered)}")
 
 
 def config() -> RunConfig:
@@ -51,6 +57,11 @@ def test_chunk_0_needs_no_advance_and_each_chunk_its_link() -> None:
     assert chunk0.args[3:] == (0, None)  # ready as soon as the recording is open
     assert chunk1.args[3:] == (1, adv0) and chunk2.args[3:] == (2, adv1)
     assert all(f.args[0] is opened and f.args[2] == plan for f in futures[:5])
+    # Chunk 0's config is the one input every worker holds (scattered to all), so that any
+    # worker may take it; the others get the config itself.
+    assert client.scattered == [(config(), {"broadcast": True, "hash": False})]
+    assert chunk0.args[1] == Submitted(client.scatter, (config(),), "scattered-1")
+    assert chunk1.args[1] == config() == adv0.args[1]
     assert join is joined and join.args[4:] == (chunk0, chunk1, chunk2)
     # Keys name the task and its chunk; every submission starts its own priority generation.
     assert [f.key.rsplit("-", 1)[0] for f in futures[:5]] == [

@@ -424,9 +424,22 @@ def _submit_chunks(
     states: list[Any] = [None]
     for k in range(plan.chunks - 1):
         states.append(_submit(client, _advance, opened, config, plan, k, states[-1], index=k))
-    # Chunk 0 needs no state: it is ready as soon as the recording is open.
+    # Chunk 0 needs no state: it is ready as soon as the recording is open. Dask places a
+    # task only on a worker that holds one of its inputs, so chunk 0 would queue behind the
+    # advance pass on the prepare task's worker until work stealing moved it (1.3-4 s at a
+    # load of 12-22). Its config, scattered to every worker, makes each one a candidate.
+    anywhere = client.scatter(config, broadcast=True, hash=False)
     parts = [
-        _submit(client, _detect_chunk, opened, config, plan, k, states[k], index=k)
+        _submit(
+            client,
+            _detect_chunk,
+            opened,
+            anywhere if k == 0 else config,
+            plan,
+            k,
+            states[k],
+            index=k,
+        )
         for k in range(plan.chunks)
     ]
     return _submit(client, _join, path, opened, config, cache_root, *parts)
