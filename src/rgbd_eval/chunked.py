@@ -42,8 +42,9 @@ class ChunkPlan:
     before it, so with a cost ``r > 0`` the chunks shrink geometrically, each by a factor
     ``1 - r``: then ``r * start_k + length_k`` is the same for every chunk, and a worker
     that advances over chunk 0 and then detects chunk 1 ends with the worker that detects
-    chunk 0 (exact for two chunks; later chunks share the chain's links, so it is an
-    upper bound for more). 0 gives chunks of equal length. Results never depend on it.
+    chunk 0 (exact for two chunks; for more, an approximation: the model charges each
+    chunk its whole advance chain, whose links are in fact shared). 0 gives chunks of
+    equal length. Results never depend on it.
     """
 
     chunks: int
