@@ -15,7 +15,7 @@ per-prefix sums are Dask's fine performance metrics) placed on the task graph
 ``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run and on two
 for ``local:2``'s: the makespans an idle machine would give, without transfer,
 scheduling or start-up costs. The JSON holds each run's per-task CPU seconds and
-its timeline (task, worker, start, stop).
+its timeline (task, action, worker, start, stop).
 
     .venv/bin/python bench/dask_scaling.py               # moving_complex, 3 reps: ~2.5 min idle
     .venv/bin/python bench/dask_scaling.py --json runs/bench/dask_scaling.json
