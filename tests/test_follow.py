@@ -143,3 +143,40 @@ def test_closed_loop_keeps_a_target_walking_straight(tmp_path: Path) -> None:
     # deterministic: the first frames again give the same steps
     again = follow(parse_scenario(_walker()), 7, max_frames=6)
     assert again.steps == result.steps[:6]
+
+
+def test_the_method_runs_on_one_opencv_thread_and_its_cpu_time_excludes_rendering(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    # The timing claim of `reproduce satake2009` is the detector's and tracker's CPU time
+    # per frame, one core's work: OpenCV runs on one thread while the loop runs (so
+    # process_time counts no thread pool), and its setting is restored afterwards.
+    import cv2
+
+    from rgbd_eval import follow as follow_module
+
+    seen: list[int] = []
+    real = follow_module.create_detector
+
+    def spy(config: Any) -> Any:
+        detector = real(config)
+        detect = detector.detect
+
+        def counted(frame: Any) -> Any:
+            seen.append(cv2.getNumThreads())
+            return detect(frame)
+
+        detector.detect = counted  # type: ignore[method-assign]
+        return detector
+
+    monkeypatch.setattr(follow_module, "create_detector", spy)
+    before = cv2.getNumThreads()
+    cv2.setNumThreads(2)  # a thread pool, as on any multi-core machine
+    try:
+        result = follow(parse_scenario(_walker()), 7, max_frames=2)
+        assert seen == [1, 1]
+        assert cv2.getNumThreads() == 2
+    finally:
+        cv2.setNumThreads(before)
+    assert set(result.cpu_s) == {"render", "detect", "track"}
+    assert result.cpu_s["detect"] > 0.0 and result.cpu_s["render"] > 0.0
