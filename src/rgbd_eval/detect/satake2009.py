@@ -43,6 +43,15 @@ class Satake2009DetectorConfig(ComponentConfig):
     height: int = Field(384, ge=32, le=4096, description="processed height (seed 4: 384)")
     num_disparities: int = Field(32, ge=16, le=512, description="SGBM disparity range (px)")
     block_size: int = Field(5, ge=1, le=21, description="SGBM block size (odd)")
+    uniqueness_ratio: int = Field(
+        10, ge=0, le=100, description="SGBM: best cost beats the second by this % (0: no test)"
+    )
+    speckle_window: int = Field(
+        100,
+        ge=0,
+        le=10000,
+        description="SGBM: disparity blobs smaller than this are dropped (0: off)",
+    )
     template_rows: int = Field(
         16, ge=8, le=512, description="search at the image step where a template is this tall"
     )
@@ -60,7 +69,12 @@ class Satake2009DetectorConfig(ComponentConfig):
     @property
     def sgbm(self) -> stereo.SgbmParams:
         """The SGBM settings."""
-        return stereo.SgbmParams(self.num_disparities, self.block_size)
+        return stereo.SgbmParams(
+            self.num_disparities,
+            self.block_size,
+            uniqueness_ratio=self.uniqueness_ratio,
+            speckle_window=self.speckle_window,
+        )
 
     @property
     def size(self) -> tuple[int, int]:
@@ -76,7 +90,7 @@ class Satake2009DetectorConfig(ComponentConfig):
     def _check(self) -> Satake2009DetectorConfig:
         if self.max_distance_m <= self.min_distance_m:
             raise ValueError("max_distance_m must exceed min_distance_m")
-        stereo.SgbmParams(self.num_disparities, self.block_size)  # ValueError if invalid
+        _ = self.sgbm  # ValueError if invalid
         return self
 
 
