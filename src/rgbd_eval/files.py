@@ -127,13 +127,17 @@ def _expanded_size(value: Any, limit: int) -> int:
     return count
 
 
-def parse_yaml(text: str, error: ErrorFactory) -> Any:
-    """Parse YAML text: duplicate keys and alias bombs are errors; messages kept short."""
+def parse_yaml(text: str, error: ErrorFactory, limit: int = MAX_YAML_VALUES) -> Any:
+    """Parse YAML text: duplicate keys and alias bombs are errors; messages kept short.
+
+    ``limit`` bounds the values after alias expansion (data files such as a dataset's
+    annotations hold more than any configuration).
+    """
     try:
         data = yaml.load(text, Loader=_StrictLoader)  # a SafeLoader subclass
     except yaml.YAMLError as err:
         message = " ".join(str(err).split())
         raise error(f"not valid YAML ({message[:300]})") from err
-    if _expanded_size(data, MAX_YAML_VALUES) > MAX_YAML_VALUES:
-        raise error(f"YAML expands to more than {MAX_YAML_VALUES} values through aliases")
+    if _expanded_size(data, limit) > limit:
+        raise error(f"YAML expands to more than {limit} values through aliases")
     return data

@@ -17,6 +17,7 @@ from rgbd_eval import __version__
 from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.cli.common import Interrupted, one_line
 from rgbd_eval.cli.compare_cmd import compare
+from rgbd_eval.cli.import_cmd import import_
 from rgbd_eval.cli.inspect_cmd import inspect
 from rgbd_eval.cli.methods_cmd import methods
 from rgbd_eval.cli.reproduce_cmd import reproduce
@@ -42,6 +43,7 @@ app.command("reproduce")(reproduce)
 app.command("bench")(bench)
 app.command("score")(score)
 app.command("methods")(methods)
+app.command("import")(import_)
 
 
 def _version(value: bool) -> None:

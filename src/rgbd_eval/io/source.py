@@ -114,9 +114,10 @@ class AnyReaderSource(MessageSource):
         try:
             for conn, log_ns, raw in self._reader.messages(connections=conns):
                 yield conn.topic, log_ns, raw
-        except AssertionError as err:
+        except (AssertionError, KeyError) as err:
             # rosbags' ROS1 reader asserts that a message record's time equals its index
-            # entry's: a flipped byte in either was an AssertionError traceback.
+            # entry's, and looks its connection id up in a dict: a flipped byte in either
+            # was an AssertionError or KeyError traceback.
             raise Ros1ReaderError("index and message record disagree: the bag is corrupt") from err
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
