@@ -127,12 +127,15 @@ class Satake2009Detector:
         self._scaled: dict[tuple[float, float], list[st.DistanceTemplate]] = {}
         self.last_timings: Mapping[str, float] = {}
 
-    def candidates(self, depth: np.ndarray, fx: float) -> list[st.Match]:
+    def candidates(
+        self, depth: np.ndarray, fx: float, far: np.ndarray | None = None
+    ) -> list[st.Match]:
         """Matches above ``min_score`` at every searched distance, best first, suppressed."""
         c = self.cfg
         found = search.search_whole(
-            depth, fx, self.templates, self.distances, c.template_rows, c.match, cache=self._scaled
-        )
+            depth, fx, self.templates, self.distances, c.template_rows, c.match,
+            cache=self._scaled, far=far,
+        )  # fmt: skip
         return search.suppress(found, c.nms_iou)
 
     def detect(self, frame: Frame) -> list[Detection]:
@@ -141,7 +144,7 @@ class Satake2009Detector:
         sd = search.frame_depth(frame, self.cfg.size, self.cfg.sgbm)
         t1 = time.perf_counter()
         cam, depth = sd.camera, sd.depth
-        matches = self.candidates(depth, cam.fx)
+        matches = self.candidates(depth, cam.fx, sd.far)
         t2 = time.perf_counter()
         c = self.cfg
         rgb = (

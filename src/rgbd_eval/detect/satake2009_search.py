@@ -158,14 +158,16 @@ def search_whole(
     params: MatchParams,
     per_template: int = 20,
     cache: dict[tuple[float, float], list[st.DistanceTemplate]] | None = None,
+    far: NDArray[np.float32] | None = None,
 ) -> list[st.Match]:
     """Matches above ``min_score`` anywhere, at each distance, before suppression.
 
-    ``cache`` keeps the scaled templates between calls (the distances are a fixed grid).
+    ``cache`` keeps the scaled templates between calls (the distances are a fixed grid);
+    ``far`` is ``depth`` with NaN as +inf when the caller has it (:attr:`StereoDepth.far`).
     """
     found: list[st.Match] = []
     cache = {} if cache is None else cache
-    filled = st.no_depth_far(depth)
+    filled = st.no_depth_far(depth) if far is None else far
     for D in distances:
         n = level(templates, D, fx, rows)
         maps = _reduced(filled, D, n, params)
@@ -201,12 +203,14 @@ def search_around(
     rows: int,
     params: MatchParams,
     cache: dict[tuple[float, float], list[st.DistanceTemplate]] | None = None,
+    far: NDArray[np.float32] | None = None,
 ) -> st.Match | None:
     """The best template whose head top lies within ``radius_px`` of ``head`` (None: none fits).
 
     Only the window the templates can cover is scored, so the cost does not grow with
     the image. The winner may score below ``min_score``: the caller decides. ``cache``
-    keeps scaled templates (worth it when the caller quantises the distances).
+    keeps scaled templates (worth it when the caller quantises the distances); ``far``
+    is as for :func:`search_whole`.
     """
     H, W = depth.shape
     u0, v0 = head
@@ -228,7 +232,10 @@ def search_around(
         bottom = min(H, math.ceil(v0 + radius_px + max(t.mask.shape[0] - t.anchor[1] for t in scaled) / k))  # fmt: skip
         if right - left < 2 or bottom - top < 2:
             continue
-        maps = _reduced(st.no_depth_far(depth[top:bottom, left:right]), D, n, params)
+        window = (slice(top, bottom), slice(left, right))
+        maps = _reduced(
+            st.no_depth_far(depth[window]) if far is None else far[window], D, n, params
+        )
         for t in scaled:
             th, tw = t.mask.shape
             if th > maps.diff.shape[0] or tw > maps.diff.shape[1]:

@@ -252,8 +252,10 @@ class Agreement:
         if H * W < DFT_MIN_PIXELS:
             return [self.score(t) if ok else None for t, ok in zip(templates, fits, strict=True)]
         shape = (cv2.getOptimalDFTSize(H), cv2.getOptimalDFTSize(W))
-        padded = np.zeros(shape, np.float32)
-        padded[:H, :W] = self.diff
+        padded = self.diff
+        if shape != (H, W):
+            padded = np.zeros(shape, np.float32)
+            padded[:H, :W] = self.diff
         spec = cv2.dft(padded, nonzeroRows=H)
         out: list[NDArray[np.float32] | None] = []
         for t, ok in zip(templates, fits, strict=True):
