@@ -9,11 +9,13 @@ of every worker process, the load average before and after, and from the Dask ta
 stream each worker's busy seconds and the makespan; then the medians and ratios.
 
 The wall-clock ratio is what an idle machine shows. On a shared one it is noise,
-so the script also gives an estimate that the load does not move: the thread CPU
-seconds of every task (Dask's fine performance metrics, per task prefix) placed on
-the task graph ``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run
-and on two for ``local:2``'s: the makespans an idle machine would give, without
-transfer, scheduling or start-up costs.
+so the script also gives an estimate that the load moves less: the thread CPU
+seconds of every task (each task function records its own, :func:`_instrument`; the
+per-prefix sums are Dask's fine performance metrics) placed on the task graph
+``run_sweep`` submits, list-scheduled on one slot for ``local:1``'s run and on two
+for ``local:2``'s: the makespans an idle machine would give, without transfer,
+scheduling or start-up costs. The JSON holds each run's per-task CPU seconds and
+its timeline (task, action, worker, start, stop).
 
     .venv/bin/python bench/dask_scaling.py               # moving_complex, 3 reps: ~2.5 min idle
     .venv/bin/python bench/dask_scaling.py --json runs/bench/dask_scaling.json
@@ -37,6 +39,7 @@ from contextlib import ExitStack
 from pathlib import Path
 from typing import Any
 
+import rgbd_eval.cli  # noqa: F401  # first: the CLI's one-thread environment
 from rgbd_eval import datasets
 from rgbd_eval.config import load_config
 from rgbd_eval.engine import ClusterSpec, connect
@@ -64,7 +67,7 @@ def _process_cpu(client: Any, in_process: bool) -> float:
     """CPU seconds of the client process, plus the worker processes when they are others."""
     if in_process:
         return _cpu_here()
-    return _cpu_here() + sum(client.run(_worker_cpu).values())
+    return _cpu_here() + float(sum(client.run(_worker_cpu).values()))
 
 
 def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
@@ -86,6 +89,27 @@ def _stream_stats(records: list[dict[str, Any]]) -> dict[str, Any]:
         "makespan_s": round(makespan, 3),
         "utilisation": round(utilisation, 3),
     }
+
+
+def _timeline(records: list[dict[str, Any]]) -> list[tuple[str, str, str, float, float]]:
+    """``(task, action, worker, start, stop)`` of every span of the task stream (compute, and
+    transfer of the task's inputs to its worker), seconds from the first start."""
+    spans = [
+        (
+            str(rec["key"]).rsplit("-", 1)[0],
+            str(s["action"]),
+            str(rec["worker"]),
+            s["start"],
+            s["stop"],
+        )
+        for rec in records
+        for s in rec.get("startstops", ())
+    ]
+    t0 = min((s[3] for s in spans), default=0.0)
+    return sorted(
+        ((k, a, w[-5:], round(b - t0, 3), round(c - t0, 3)) for k, a, w, b, c in spans),
+        key=lambda span: span[3],
+    )
 
 
 async def _heartbeat(dask_worker: Any) -> None:
@@ -127,32 +151,80 @@ def _schedule(tasks: list[tuple[str, float, list[str]]], workers: int) -> float:
     return max(done.values())
 
 
-def _sweep_graph(
-    cpu: dict[str, float], counts: dict[str, int]
-) -> list[tuple[str, float, list[str]]]:
-    """The task graph ``run_sweep`` submits for one recording, each task taking its prefix's
-    measured thread CPU seconds divided evenly among the prefix's tasks."""
+#: The sweep's task functions (rgbd_eval.sweep), each timed by :func:`_instrument`.
+TASKS = ("_prepare", "_advance", "_detect_chunk", "_join", "_brief", "_track", "_score")
 
-    def each(prefix: str) -> float:
-        return cpu.get(prefix, 0.0) / max(1, counts.get(prefix, 1))
 
-    graph = [("prepare", each("prepare"), [])]
-    chunks = counts.get("detect_chunk", 0)
+def _instrument() -> None:
+    """Make the sweep's task functions in this process record their thread CPU seconds in
+    their task's metadata, which the task stream carries (run on every worker)."""
+    import functools
+
+    from distributed import get_worker
+
+    from rgbd_eval import sweep
+
+    def timed(func: Any) -> Any:
+        @functools.wraps(func)
+        def run(*args: Any) -> Any:
+            start = time.thread_time()
+            try:
+                return func(*args)
+            finally:
+                worker = get_worker()
+                task = worker.state.tasks.get(worker.get_current_task())
+                if task is not None:
+                    task.metadata["thread_cpu_s"] = time.thread_time() - start
+
+        return run
+
+    for name in TASKS:
+        func = getattr(sweep, name)
+        if not hasattr(func, "__wrapped__"):
+            setattr(sweep, name, timed(func))
+
+
+def _task_costs(records: list[dict[str, Any]]) -> dict[str, float]:
+    """Thread CPU seconds of each task, by its name (``prefix`` or ``prefix-index``)."""
+    from dask.utils import key_split
+
+    out = {}
+    for rec in records:
+        key = str(rec["key"])
+        prefix = key_split(key).lstrip("_")
+        parts = key.split("-")
+        name = f"{prefix}-{parts[1]}" if len(parts) == 3 and parts[1].isdigit() else prefix
+        out[name] = float((rec.get("metadata") or {}).get("thread_cpu_s", 0.0))
+    return out
+
+
+def _sweep_graph(costs: dict[str, float]) -> list[tuple[str, float, list[str]]]:
+    """The task graph ``run_sweep`` submits for one recording, in submission order, each task
+    with its thread CPU seconds (:func:`_task_costs`)."""
+
+    def named(prefix: str) -> list[str]:
+        return sorted(
+            (n for n in costs if n.split("-")[0] == prefix), key=lambda n: int(n[len(prefix) + 1 :])
+        )
+
+    graph: list[tuple[str, float, list[str]]] = [("prepare", costs["prepare"], [])]
     last = "prepare"
+    chunks = named("detect_chunk")
     if chunks:
-        state = None
-        for k in range(chunks - 1):
-            graph.append(
-                (f"advance{k}", each("advance"), ["prepare"] + ([state] if state else []))
-            )
-            state = f"advance{k}"
-        for k in range(chunks):
-            deps = ["prepare"] + ([f"advance{k - 1}"] if k else [])
-            graph.append((f"chunk{k}", each("detect_chunk"), deps))
-        graph.append(("join", each("join"), ["prepare"] + [f"chunk{k}" for k in range(chunks)]))
+        advances = named("advance")
+        for k, name in enumerate(advances):
+            graph.append((name, costs[name], ["prepare"] + advances[k - 1 : k] * (k > 0)))
+        for k, name in enumerate(chunks):
+            graph.append((name, costs[name], ["prepare"] + advances[k - 1 : k] * (k > 0)))
+        graph.append(("join", costs["join"], ["prepare", *chunks]))
         last = "join"
-    graph.append(("brief", each("brief"), [last]))
-    graph += [(f"track{i}", each("track"), [last]) for i in range(counts.get("track", 0))]
+    graph.append(("brief", costs["brief"], [last]))
+    tracks = named("track")
+    graph += [(name, costs[name], [last]) for name in tracks]
+    graph += [
+        (f"score-{name.split('-')[1]}", costs[f"score-{name.split('-')[1]}"], [last, name])
+        for name in tracks
+    ]
     return graph
 
 
@@ -177,7 +249,8 @@ def _one_run(
     for rec in stream.data:
         prefix = key_split(rec["key"]).lstrip("_")
         counts[prefix] = counts.get(prefix, 0) + 1
-    graph = _sweep_graph(task_cpu, counts)
+    costs = _task_costs(stream.data)
+    graph = _sweep_graph(costs)
     if result.failures:
         raise SystemExit(f"sweep failed: {result.failures[0].error}")
     return {
@@ -191,6 +264,8 @@ def _one_run(
         "records": [(r.point, r.counts) for r in result.records],
         "task_cpu_s": task_cpu,
         "task_counts": counts,
+        "task_cpu_each_s": {k: round(v, 3) for k, v in costs.items()},
+        "timeline": _timeline(stream.data),
         # Idle-machine makespans of this run's graph from its tasks' CPU seconds.
         "estimate_1_s": round(_schedule(graph, 1), 3),
         "estimate_2_s": round(_schedule(graph, 2), 3),
@@ -234,6 +309,7 @@ def main() -> int:
                 t0 = time.perf_counter()
                 clients[n] = stack.enter_context(connect(ClusterSpec(None, n)))
                 startup[n] = round(time.perf_counter() - t0, 3)
+                clients[n].run(_instrument)
                 print(f"local:{n} started in {startup[n]:.2f} s (wall)")
             reference = None
             for rep in range(args.reps):

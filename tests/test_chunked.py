@@ -7,7 +7,7 @@ import pickle
 import numpy as np
 import pytest
 
-from rgbd_eval.chunked import ChunkPlan, advance, detect_chunk, join, resumable
+from rgbd_eval.chunked import ChunkPlan, advance, advance_cost, detect_chunk, join, resumable
 from rgbd_eval.config import RunConfig, build_config, load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.detect.basso2012 import Basso2012Detector
@@ -45,9 +45,33 @@ def test_spans_cover_the_frames_in_order() -> None:
     assert ChunkPlan(2, 60).spans(59) == [(0, 59), (59, 59)]
 
 
+def test_spans_shrink_by_the_advance_cost() -> None:
+    # r = 0.25, 2 chunks: lengths in proportion 1 : 0.75, bound int(70 / 1.75) = 40. The
+    # worker detecting chunk 0 does 40 frames; the one advancing over 0:40 (a quarter of a
+    # detection each) and detecting 40:70 does 0.25 * 40 + 30 = 40 too.
+    assert ChunkPlan(2, 1, 0.25).spans(70) == [(0, 40), (40, 70)]
+    # r = 0.5, 3 chunks: 1 : 0.5 : 0.25, cumulative 1, 1.5, 1.75 of 70 -> 40, 60, 70.
+    assert ChunkPlan(3, 1, 0.5).spans(70) == [(0, 40), (40, 60), (60, 70)]
+    # The last chunk (30 frames) is under min_frames 31: one chunk fewer, the rest empty.
+    assert ChunkPlan(2, 30, 0.25).spans(70) == [(0, 40), (40, 70)]
+    assert ChunkPlan(2, 31, 0.25).spans(70) == [(0, 70), (70, 70)]
+    # 0 is the equal split.
+    assert ChunkPlan(2, 1, 0.0).spans(70) == [(0, 35), (35, 70)]
+
+
+def test_advance_cost_is_declared_by_the_detector() -> None:
+    assert advance_cost(config()) == Basso2012Detector.advance_cost
+    assert 0.0 < Basso2012Detector.advance_cost < 1.0
+    assert ChunkPlan(2, advance_cost=advance_cost(config())).spans(750)[0][1] > 375
+    assert advance_cost(config("pinto2022")) == 0.0  # not resumable: declares none
+
+
 def test_plan_refuses_zero_chunks() -> None:
     with pytest.raises(ConfigError, match="at least 1"):
         ChunkPlan(0)
+    for cost in (-0.1, 1.0):
+        with pytest.raises(ConfigError, match="advance_cost"):
+            ChunkPlan(2, advance_cost=cost)
 
 
 def test_frame_range_and_skipped_roles(recording: Recording) -> None:
@@ -67,14 +91,17 @@ def test_frame_range_and_skipped_roles(recording: Recording) -> None:
         list(recording.frames(3, FRAMES + 1))
 
 
-@pytest.mark.parametrize("chunks", [2, 5])
-def test_chunks_equal_one_pass_bit_for_bit(recording: Recording, chunks: int) -> None:
+@pytest.mark.parametrize(("chunks", "cost"), [(2, 0.0), (5, 0.0), (3, 0.5)])
+def test_chunks_equal_one_pass_bit_for_bit(recording: Recording, chunks: int, cost: float) -> None:
     cfg = config()
     assert resumable(cfg)
     whole = detect_sequence(recording, cfg)
     # Not vacuous: people are detected, before and after the first chunk boundary.
     assert sum(map(len, whole.detections[:4])) > 0 and sum(map(len, whole.detections[8:])) > 0
-    spans = ChunkPlan(chunks, 1).spans(len(recording))
+    # 24 frames, 3 chunks at cost 0.5: 1 : 0.5 : 0.25 of 24 -> bounds 13, 20 (unequal chunks).
+    spans = ChunkPlan(chunks, 1, cost).spans(len(recording))
+    if cost:
+        assert spans == [(0, 13), (13, 20), (20, 24)]
     state: object | None = None
     parts = []
     for span in spans:

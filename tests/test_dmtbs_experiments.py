@@ -46,7 +46,8 @@ def _frames(n: int) -> list[TofFrame]:
 
 
 def test_run_frames_scores_after_the_initialisation() -> None:
-    det = DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2))
+    # The 6x6-pixel box top is ~0.026 m^2 of surface, below the default smallest blob.
+    det = DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2), min_blob_area_m2=0.0)
     run = run_frames(_frames(8), ["a"], det, DmtbsTrackerConfig(confirm_hits=3))
     row = run.row()
     # Frames 2..7 are scored (6 instances); the track is confirmed at its third hit (frame 4),
@@ -172,3 +173,56 @@ def test_an_object_left_behind_is_tracked_from_its_third_frame() -> None:
     assert (row["object_frames"], row["object_tracked_frames"]) == (30, 28)
     assert row["object_tracked_share"] == pytest.approx(28 / 30)
     assert row["fp"] == 28 and row["num_gt"] == 0
+
+
+def _walker_scene() -> Scenario:
+    """One person walking 1 m across a 64x48 camera's view for 1.5 s (45 frames), with noise."""
+    return parse_scenario(
+        {
+            "name": "walker",
+            "duration_s": 1.5,
+            "seed": 1,
+            "room": {"x_min": -2, "x_max": 2, "y_min": -2, "y_max": 2, "walls": False},
+            "truth_visibility": "present",
+            "rig": [
+                {
+                    "kind": "static_depth",
+                    "name": "cam",
+                    "x": -3.0,
+                    "y": 0.0,
+                    "z": 3.0,
+                    "pitch_deg": 40.0,
+                    "width": 64,
+                    "height": 48,
+                    "noise_k": 0.0002,
+                    "random_dropout": 0.05,
+                }
+            ],
+            "people": [
+                {"id": 1, "height": 1.8, "path": [{"x": 0.0, "y": -0.5}, {"x": 0.0, "y": 0.5}]}
+            ],
+        }
+    )
+
+
+def test_camera_angle_pools_the_runs_of_each_angle() -> None:
+    from rgbd_eval.methods.dmtbs_experiments import camera_angle
+
+    scene = _walker_scene()
+    det = DmtbsDetectorConfig(init_frames=10, roi=(-2, -2, 2, 2), min_blob_area_m2=0.0)
+    trk = DmtbsTrackerConfig()
+    args = ([90.0], (0.0, 0.0, 1.0), 5.0)
+    both = camera_angle(scene, det, trk, args[0], args[1], args[2], [1, 2])
+    one = [camera_angle(scene, det, trk, args[0], args[1], args[2], [s])[0] for s in (1, 2)]
+    (row,) = both
+    # Frames 10-44 are scored in each run (35 ground-truth instances): 70 pooled; the pooled
+    # counts are the runs' sums, and the pooled MOTA lies between the runs' (it is their
+    # mean weighted by ground truth, here equal).
+    assert row["runs"] == 2 and row["num_gt"] == 70 == one[0]["num_gt"] + one[1]["num_gt"]
+    for key in ("fp", "fn", "id_switches", "splits"):
+        assert row[key] == one[0][key] + one[1][key], key
+    assert row["mota"] == pytest.approx((one[0]["mota"] + one[1]["mota"]) / 2)
+    assert row["mota_min"] == min(one[0]["mota"], one[1]["mota"])
+    assert row["mota_max"] == max(one[0]["mota"], one[1]["mota"])
+    with pytest.raises(ValueError, match="at least one seed"):
+        camera_angle(scene, det, trk, args[0], args[1], args[2], [])

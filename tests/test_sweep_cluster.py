@@ -102,13 +102,14 @@ def test_two_workers_equal_one_bit_for_bit(
     ]
 
 
+@pytest.mark.parametrize("plan", [ChunkPlan(3, 3), ChunkPlan(2, 3, 0.5)])
 def test_detection_in_chunks_equals_one_pass(
-    recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path
+    recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path, plan: ChunkPlan
 ) -> None:
-    """Each recording detected in 3 chunks of 3 or more frames (12 -> 4+4+4, 10 -> 3+3+4)
-    on the two workers: the same detections in the cache entries, and the same records."""
+    """Each recording detected in 3 chunks of 3 or more frames (12 -> 4+4+4, 10 -> 3+3+4), or
+    in 2 unequal ones (advance cost 0.5: 1 : 0.5, so 12 -> 8+4 and 10 -> int(10/1.5) = 6,
+    then 4) on the two workers: the same detections in the cache entries, the same records."""
     grid, configs = grid_and_configs()
-    plan = ChunkPlan(3, 3)
     cold = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
     warm = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
     assert (cold.cache_misses, warm.cache_hits, cold.failures) == (2, 2, ())
@@ -123,6 +124,20 @@ def test_detection_in_chunks_equals_one_pass(
         assert twin.exists() and a is not None and b is not None
         assert a.stamps_ns == b.stamps_ns
         assert pickle.dumps(a.detections) == pickle.dumps(b.detections)
+
+
+def test_default_split_of_one_recording(
+    recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path
+) -> None:
+    """One recording on two workers takes the default split graph (advance, chunks, join;
+    12 frames hold one chunk of the 60-frame minimum, the second is empty): the same records
+    as local:1's. The workers run without Dask's malloc setting."""
+    grid, configs = grid_and_configs()
+    one = run_sweep(recordings[:1], grid, configs, client2, cache_root=tmp_path)
+    name = one.records[0].sequence
+    assert one.cache_misses == 1
+    assert records(one) == [r for r in records(reference) if r[1] == name]
+    assert set(client2.run(os.environ.get, "MALLOC_TRIM_THRESHOLD_").values()) == {None}
 
 
 def test_a_bad_recording_fails_alike_in_chunks(client2: Any, tmp_path: Path) -> None:

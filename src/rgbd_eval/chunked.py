@@ -35,29 +35,60 @@ MIN_CHUNK_FRAMES = 60
 
 @dataclass(frozen=True)
 class ChunkPlan:
-    """Split a recording's detection into at most ``chunks`` pieces of ``min_frames`` or more."""
+    """Split a recording's detection into at most ``chunks`` pieces of ``min_frames`` or more.
+
+    ``advance_cost``: the advance pass's cost per frame as a fraction of a detection's
+    (:func:`advance_cost`). Chunk ``k`` waits for the advance pass over the frames
+    before it, so with a cost ``r > 0`` the chunks shrink geometrically, each by a factor
+    ``1 - r``: then ``r * start_k + length_k`` is the same for every chunk, and a worker
+    that advances over chunk 0 and then detects chunk 1 ends with the worker that detects
+    chunk 0 (exact for two chunks; for more, an approximation: the model charges each
+    chunk its whole advance chain, whose links are in fact shared). 0 gives chunks of
+    equal length. Results never depend on it.
+    """
 
     chunks: int
     min_frames: int = MIN_CHUNK_FRAMES
+    advance_cost: float = 0.0
 
     def __post_init__(self) -> None:
         if self.chunks < 1 or self.min_frames < 1:
             raise ConfigError(
                 f"chunks ({self.chunks}) and min_frames ({self.min_frames}) must be at least 1"
             )
+        if not 0.0 <= self.advance_cost < 1.0:
+            raise ConfigError(f"advance_cost ({self.advance_cost}) must be in [0, 1)")
 
     def spans(self, frames: int) -> list[tuple[int, int]]:
         """``chunks`` frame ranges covering ``0:frames`` in order; the tail ones empty when
         the recording is too short for that many chunks of ``min_frames``."""
         used = max(1, min(self.chunks, frames // self.min_frames))
-        bounds = [frames * i // used for i in range(used + 1)]
+        while True:
+            bounds = self._bounds(frames, used)
+            if used == 1 or min(b - a for a, b in itertools.pairwise(bounds)) >= self.min_frames:
+                break
+            used -= 1  # the geometric shrink left the last chunk too short
         spans = list(itertools.pairwise(bounds))
         return spans + [(frames, frames)] * (self.chunks - used)
+
+    def _bounds(self, frames: int, used: int) -> list[int]:
+        """Chunk boundaries: lengths in proportion to ``(1 - r)**k``, rounded down."""
+        if self.advance_cost == 0.0:
+            return [frames * i // used for i in range(used + 1)]
+        weights = list(itertools.accumulate((1.0 - self.advance_cost) ** k for k in range(used)))
+        return [0] + [int(frames * w / weights[-1]) for w in weights[:-1]] + [frames]
 
 
 def resumable(config: RunConfig) -> bool:
     """Whether the configured detector can be detected in chunks."""
     return isinstance(create_detector(config), ResumableDetector)
+
+
+def advance_cost(config: RunConfig) -> float:
+    """The configured detector's ``advance_cost`` (an advance pass's cost per frame as a
+    fraction of a detection's, which a :class:`ResumableDetector` may declare), else 0."""
+    value = getattr(create_detector(config), "advance_cost", 0.0)
+    return float(value) if isinstance(value, int | float) and 0.0 <= value < 1.0 else 0.0
 
 
 def advance(

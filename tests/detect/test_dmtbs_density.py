@@ -146,3 +146,23 @@ def test_blur_spreads_an_isolated_cell_below_the_threshold() -> None:
     d[4:7, 4:7] = 1.0
     binary, _ = blob_mask(d, grid, blur_sigma_m=0.02, threshold=0.5, closing_radius_m=0.0)
     assert binary[5, 5] == 1
+
+
+def test_blobs_smaller_than_the_minimum_surface_are_dropped() -> None:
+    # Two squares of density 4 on a 1 cm grid: 100 cells of 1e-4 m^2 each -> 4 * 100 * 1e-4
+    # = 0.04 m^2 of surface per square. Shrink the second to 5x5 cells: 4 * 25 * 1e-4 =
+    # 0.01 m^2. With min_area 0.02 only the first is kept, renumbered 1, and the second's
+    # cells are labelled 0.
+    d, grid = _squares(gap_cells=20)
+    d[10:20, 40:50] = 0.0
+    d[10:15, 40:45] = 4.0
+    binary, _ = blob_mask(d, grid, blur_sigma_m=0.0, threshold=1.0, closing_radius_m=0.0)
+    blobs, _ = find_blobs(binary, d, grid)
+    assert sorted(round(b.area_m2, 6) for b in blobs) == [0.01, 0.04]
+    kept, labels = find_blobs(binary, d, grid, min_area_m2=0.02)
+    assert [b.centroid for b in kept] == [pytest.approx((0.15, 0.15))]
+    assert kept[0].area_m2 == pytest.approx(0.04)
+    assert labels.max() == 1 and int((labels == 1).sum()) == 100
+    assert labels[10:15, 40:45].sum() == 0
+    with pytest.raises(ValueError, match="min_area_m2"):
+        find_blobs(binary, d, grid, min_area_m2=-1.0)

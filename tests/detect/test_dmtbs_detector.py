@@ -40,6 +40,11 @@ def _with_box(floor: np.ndarray) -> np.ndarray:
     return d
 
 
+#: The box top is 6x6 pixels at 1.2 m from a 64x48 camera: about 0.026 m^2 of surface, below
+#: the default smallest blob (a head, 0.04 m^2); these tests keep every blob.
+KEEP_ALL = 0.0
+
+
 def _box_xy(cam: StaticDepthCamera) -> np.ndarray:
     """World (x, y) of the box-top pixels' mean, by back-projection."""
     pts = cam.camera.backproject(_with_box(np.full((48, 64), np.nan, dtype=np.float32)))
@@ -49,7 +54,9 @@ def _box_xy(cam: StaticDepthCamera) -> np.ndarray:
 
 def test_one_camera_one_box() -> None:
     spec, floor = _overhead("a", 0.0, 0.0)
-    det = DmtbsDetector(DmtbsDetectorConfig(init_frames=2, roi=(-2, -2, 2, 2)))
+    det = DmtbsDetector(
+        DmtbsDetectorConfig(min_blob_area_m2=KEEP_ALL, init_frames=2, roi=(-2, -2, 2, 2))
+    )
     for k in range(2):  # initialisation: nothing detected
         assert det.detect_views(k * STEP, _views([spec], [floor])).detections == []
     result = det.detect_views(2 * STEP, _views([spec], [_with_box(floor)]))
@@ -70,7 +77,9 @@ def test_one_camera_one_box() -> None:
 def test_two_cameras_merge_by_maximum() -> None:
     a, floor_a = _overhead("a", -1.0, 0.0)
     b, floor_b = _overhead("b", 1.0, 0.0)
-    det = DmtbsDetector(DmtbsDetectorConfig(init_frames=1, roi=(-2.5, -2, 2.5, 2)))
+    det = DmtbsDetector(
+        DmtbsDetectorConfig(min_blob_area_m2=KEEP_ALL, init_frames=1, roi=(-2.5, -2, 2.5, 2))
+    )
     det.detect_views(0, _views([a, b], [floor_a, floor_b]))
     result = det.detect_views(STEP, _views([a, b], [_with_box(floor_a), _with_box(floor_b)]))
     xs = sorted(d.ground_xy[0] for d in result.detections)
@@ -78,7 +87,9 @@ def test_two_cameras_merge_by_maximum() -> None:
     # The merged map is the pixel-wise maximum of each camera's own map.
     singles = []
     for spec, floor in ((a, floor_a), (b, floor_b)):
-        alone = DmtbsDetector(DmtbsDetectorConfig(init_frames=1, roi=(-2.5, -2, 2.5, 2)))
+        alone = DmtbsDetector(
+            DmtbsDetectorConfig(min_blob_area_m2=KEEP_ALL, init_frames=1, roi=(-2.5, -2, 2.5, 2))
+        )
         alone.detect_views(0, _views([spec], [floor]))
         singles.append(alone.detect_views(STEP, _views([spec], [_with_box(floor)])).density)
     np.testing.assert_array_equal(result.density, np.maximum(singles[0], singles[1]))
@@ -89,7 +100,11 @@ def test_floor_from_the_first_frame_matches_the_world_floor() -> None:
     results = []
     cases = [(FloorSource.WORLD, True), (FloorSource.FIRST_FRAME, True), (FloorSource.AUTO, False)]
     for source, world_is_floor in cases:
-        det = DmtbsDetector(DmtbsDetectorConfig(init_frames=1, floor=source, roi=(-2, -2, 2, 2)))
+        det = DmtbsDetector(
+            DmtbsDetectorConfig(
+                min_blob_area_m2=KEEP_ALL, init_frames=1, floor=source, roi=(-2, -2, 2, 2)
+            )
+        )
         det.detect_views(0, _views([spec], [floor]), world_is_floor)
         results.append(
             det.detect_views(STEP, _views([spec], [_with_box(floor)]), world_is_floor).detections
@@ -110,7 +125,9 @@ def test_no_floor_in_the_first_frame_is_a_config_error() -> None:
 def test_points_below_the_height_cut_are_not_detected() -> None:
     # A box 0.9 m tall (depth 2.1 m from 3 m): below the 1 m cut, no blob.
     spec, floor = _overhead("a", 0.0, 0.0)
-    det = DmtbsDetector(DmtbsDetectorConfig(init_frames=1, roi=(-2, -2, 2, 2)))
+    det = DmtbsDetector(
+        DmtbsDetectorConfig(min_blob_area_m2=KEEP_ALL, init_frames=1, roi=(-2, -2, 2, 2))
+    )
     det.detect_views(0, _views([spec], [floor]))
     low = floor.copy()
     low[22:28, 30:36] = 2.1

@@ -8,11 +8,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import load_ground_truth
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import load_scenario, parse_scenario, synthesize
 from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.sim.tof import TofRig, radial_position, tof_depth, tof_sigma
 from rgbd_eval.types import CameraModel
 
@@ -115,6 +117,8 @@ def test_scene2_recording_round_trip(tmp_path: Path) -> None:
     rec = open_recording(out, streams=(StreamSpec("depth", multiple=True),))
     topics = set(rec.info.selected.streams.values())
     assert {f"/cam{k}/depth/image_raw" for k in range(4)} <= topics
+    # robot_camera: false: the robot's Kinect (/camera/...) is neither rendered nor written.
+    assert not [t.name for t in rec.info.topics if t.name.startswith("/camera/")]
     frame = next(iter(rec.frames()))
     memory = TofRig(scenario).frame(0)
     by_topic = {t: r for r, t in rec.info.selected.streams.items()}
@@ -129,3 +133,29 @@ def test_scene2_recording_round_trip(tmp_path: Path) -> None:
     gt = load_ground_truth(out.with_name("scene2.gt.csv"))
     objects = [o for f in gt.frames for o in f[2]]
     assert len(objects) == 8 and not any(o.ignore for o in objects)
+    # Without the Kinect there are no image boxes; the positions are the in-memory rig's.
+    assert all(o.box2d is None for o in objects)
+    first = sorted((o for o in objects if o.frame == 0), key=lambda o: o.object_id)
+    expected = sorted(memory.ground_truth, key=lambda o: o.object_id)
+    for got, want in zip(first, expected, strict=True):
+        assert got.world_xyz == pytest.approx(want.world_xyz, abs=1e-6)
+
+
+def test_no_robot_camera_needs_present_truth_and_renders_no_kinect() -> None:
+    data = {
+        "name": "rig_only",
+        "duration_s": 0.1,
+        "robot_camera": False,
+        "people": [{"id": 1, "height": 1.8, "path": [{"x": 1.0, "y": 0.5}]}],
+    }
+    with pytest.raises(ConfigError, match="truth_visibility: present"):
+        parse_scenario(data)
+    scenario = parse_scenario({**data, "truth_visibility": "present"})
+    frame = Simulator(scenario).frame(0)
+    assert frame.rgb.size == 0 and frame.depth.size == 0
+    # Everyone present is ground truth at their floor position, half their height up, with
+    # no image box (as TofRig's): the person stands at (1.0, 0.5).
+    (gt,) = frame.ground_truth
+    assert gt.box2d is None and gt.object_id == 1
+    assert gt.world_xyz[:2] == pytest.approx((1.0, 0.5))
+    assert 0.8 < gt.world_xyz[2] < 0.95

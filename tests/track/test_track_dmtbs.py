@@ -127,6 +127,27 @@ def test_age_rule_boundary_is_inclusive() -> None:
     assert tracker.splits == 1
 
 
+def test_time_spent_coasting_does_not_count_towards_the_split_age() -> None:
+    # The seed splits "blobs that have been in view for enough frames". Disc A is seen from
+    # 0.1 s on; disc B from 0.1 to 0.4 s (4 frames, confirmed at its third), then B's track
+    # coasts (max_missed 1 s) standing still while A is still seen. At 1.2 s A's blob has
+    # grown over B's prediction (the two discs touch): B is 1.1 s old but has been in view
+    # only 0.3 s (0.1 -> 0.4 s; 0.8 s coasting), so the blob is not split; B coasts on.
+    tracker = DmtbsTracker(DmtbsTrackerConfig(min_split_age_s=1.0, confirm_hits=3))
+    a, b = _disc(0.0, 0.0), _disc(0.5, 0.0)
+    for k in range(1, 12):
+        tracker.update(k * STEP_NS, [_det(a), _det(b)] if k <= 4 else [_det(a)])
+    out = tracker.update(12 * STEP_NS, [_det(_touching_discs())])
+    assert tracker.splits == 0
+    assert [o.visibility for o in out] == [Visibility.VISIBLE, Visibility.OCCLUDED]
+    # The same timeline with B seen throughout is split (test above: 1.1 s in view).
+    seen = DmtbsTracker(DmtbsTrackerConfig(min_split_age_s=1.0, confirm_hits=3))
+    for k in range(1, 12):
+        seen.update(k * STEP_NS, [_det(a), _det(b)])
+    seen.update(12 * STEP_NS, [_det(_touching_discs())])
+    assert seen.splits == 1
+
+
 def test_confirmation_and_deletion_counts() -> None:
     cfg = DmtbsTrackerConfig(confirm_hits=3, max_missed_s=0.3)
     tracker = DmtbsTracker(cfg)

@@ -107,6 +107,9 @@ class DmtbsDetectorConfig(ComponentConfig):
     closing_radius_m: float = Field(
         0.1, ge=0.0, description="disk radius of the closing (seed 003, 3.3: 10 cm)"
     )
+    min_blob_area_m2: float = Field(
+        0.04, ge=0.0, description="smallest blob surface kept (m^2; seed 003, 3.4: small objects)"
+    )
     floor: FloorSource = Field(FloorSource.AUTO, description="where the floor plane comes from")
     floor_band_m: float = Field(0.03, gt=0.0, description="RANSAC inlier band of the floor (m)")
     floor_max_tilt_deg: float = Field(
@@ -234,7 +237,7 @@ class DmtbsDetector:
         binary, blurred = blob_mask(
             density, self._grid, cfg.blur_sigma_m, cfg.density_threshold, cfg.closing_radius_m
         )
-        blobs, labels = find_blobs(binary, blurred, self._grid)
+        blobs, labels = find_blobs(binary, blurred, self._grid, cfg.min_blob_area_m2)
         detections = self._detections(blobs, labels, maps)
         timings["blobs"] = time.perf_counter() - t0
         self._last_timings = timings

@@ -206,23 +206,62 @@ def camera_angle(
     angles_deg: list[float],
     target: tuple[float, float, float],
     distance_m: float,
+    seeds: list[int],
     progress: Callable[[str], None] | None = None,
 ) -> list[dict[str, Any]]:
-    """Fig. 8: the same sequence seen by the scenario's one camera at each angle of the arc."""
+    """Fig. 8: the same sequence seen by the scenario's one camera at each angle of the arc.
+
+    Each angle is run once per seed (the sensor's noise and dropout; the people's paths are
+    the scenario's): the row's counts and MOTA are pooled over the runs (the seed reports
+    "all frames of the set"), ``mota_min`` and ``mota_max`` give the spread between runs.
+    """
     cams = [c for c in scenario.rig if isinstance(c, StaticDepthConfig)]
     if len(cams) != 1:
         raise ValueError(
             f"scenario {scenario.name!r} must have one static_depth camera, has {len(cams)}"
         )
+    if not seeds:
+        raise ValueError("camera_angle needs at least one seed")
     rows = []
     for angle in angles_deg:
         if progress is not None:
-            progress(f"Fig. 8: camera at {angle:g} deg")
+            progress(f"Fig. 8: camera at {angle:g} deg, {len(seeds)} runs")
         cam = arc_camera(cams[0], angle, target, distance_m)
-        placed = scenario.model_copy(update={"rig": [cam]})
-        run = run_frames(TofRig(placed).frames(), [cam.name], det, trk)
-        rows.append({"angle_deg": angle, "camera_height_m": round(cam.z, 3), **run.row()})
+        runs = [
+            run_frames(
+                TofRig(scenario.model_copy(update={"rig": [cam], "seed": seed})).frames(),
+                [cam.name],
+                det,
+                trk,
+            )
+            for seed in seeds
+        ]
+        pooled = sum((r.scores.counts for r in runs[1:]), runs[0].scores.counts)
+        summary = summarize(pooled)
+        motas = [_run_mota(r) for r in runs]
+        rows.append(
+            {
+                "angle_deg": angle,
+                "camera_height_m": round(cam.z, 3),
+                "runs": len(runs),
+                "mota": summary["mota"],
+                "mota_min": min(motas),
+                "mota_max": max(motas),
+                "motp_m": summary["motp"],
+                "fp": pooled.fp,
+                "fn": pooled.fn,
+                "id_switches": pooled.id_switches,
+                "num_gt": pooled.num_gt,
+                "splits": sum(r.splits for r in runs),
+            }
+        )
     return rows
+
+
+def _run_mota(run: RigRun) -> float:
+    """A run's MOTA (NaN when nothing was scored)."""
+    value = summarize(run.scores.counts)["mota"]
+    return float(value) if value is not None else float("nan")
 
 
 def left_object_frames(scenario: Scenario, left_at_s: float) -> Iterator[TofFrame]:

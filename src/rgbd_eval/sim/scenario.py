@@ -375,6 +375,12 @@ class Scenario(_Model):
         "see are ignored), or 'present': everyone in the scene counts, for static multi-camera "
         "rigs (seed 003 4.1 annotates occluded people too)",
     )
+    robot_camera: bool = Field(
+        True,
+        description="render and write the robot's Kinect (RGB and depth topics); false for "
+        "static rigs whose runs read only the rig's sensors (needs truth_visibility 'present': "
+        "the ground truth then has no image boxes)",
+    )
     rig: list[SerializeAsAny[RigSensorConfig]] = Field(
         default_factory=list,
         description="extra sensors beside the robot's Kinect, each selected by its 'kind' "
@@ -390,6 +396,11 @@ class Scenario(_Model):
 
     @model_validator(mode="after")
     def _check(self) -> Scenario:
+        if not self.robot_camera and self.truth_visibility != "present":
+            raise ValueError(
+                "robot_camera: false needs truth_visibility: present (visibility and image "
+                "boxes come from the robot's Kinect)"
+            )
         names = [r.name for r in self.rig]
         if len(set(names)) != len(names):
             raise ValueError(f"rig sensor names must be unique, got {names}")

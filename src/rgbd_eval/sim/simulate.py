@@ -221,11 +221,30 @@ class Simulator:
 
         people = self.people_meshes(t)
         people_mesh = concatenate([m for _, m, _, _ in people])
-        mesh = concatenate([self.static, people_mesh])
         people_scene = make_scene(people_mesh)
         self._people = (index, people_mesh, people_scene)
+        stamp = sc.stamp_ns(index)
+        if not sc.robot_camera:  # no Kinect: empty images, everyone present is ground truth
+            gt = [
+                GroundTruthObject(index, stamp, pid, None, (xy[0], xy[1], top / 2.0))
+                for pid, _, top, xy in people
+            ]
+            empty = np.zeros((0, 0), dtype=np.float32)
+            return SimFrame(
+                index,
+                stamp,
+                t,
+                np.zeros((0, 0, 3), dtype=np.uint8),
+                empty,
+                np.zeros((0, 0), dtype=np.int32),
+                base_true,
+                base_odom,
+                rgb_pose,
+                gt,
+            )
 
         # RGB: shaded colour and the id buffer used for visibility
+        mesh = concatenate([self.static, people_mesh])
         hits = self._render(people_mesh, people_scene, self.rgb_camera, rgb_pose)
         clean = shade(mesh, hits, self.light, sc.room.floor_tile)
         ids = object_ids(mesh, hits)
@@ -262,7 +281,6 @@ class Simulator:
             _rng(self.seed, _STREAM_DEPTH, index),
         )
 
-        stamp = sc.stamp_ns(index)
         gt = [
             person_ground_truth(index, stamp, pid, m, top, xy, ids, self.rgb_camera, rgb_pose)
             for pid, m, top, xy in people

@@ -83,12 +83,13 @@ def write_static(w: RecordingWriter, sim: Simulator, sensors: Sequence[RigSensor
 
 
 def write_frame(w: RecordingWriter, sim: Simulator, f: SimFrame) -> None:
-    """One frame's odometry, tf, Kinect images and ground truth (not the rig's sensors)."""
+    """One frame's odometry, tf, Kinect images (unless ``robot_camera`` is off) and ground truth."""
     stamp = f.stamp_ns
     w.write_odometry(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
     w.write_transform(stamp, rig.WORLD_FRAME, rig.BASE_FRAME, f.base_odom)
-    w.write_rgb(stamp, f.rgb, sim.rgb_camera)
-    w.write_depth(stamp, f.depth, sim.depth_camera)
+    if sim.scenario.robot_camera:
+        w.write_rgb(stamp, f.rgb, sim.rgb_camera)
+        w.write_depth(stamp, f.depth, sim.depth_camera)
     w.write_ground_truth(stamp, rig.WORLD_FRAME, f.ground_truth)
 
 

@@ -6,12 +6,19 @@ Per frame:
 1. predict every track with the constant-velocity model over the stamp difference;
 2. assign detections (blob centroids) to predictions by the Hungarian method on the Euclidean
    distance, refusing pairs farther apart than ``gate_m``;
-3. blob splitting: a track without a detection, older than ``min_split_age_s``, whose
-   prediction lies within ``split_near_m`` of a blob's cell, has merged with that blob. When
-   two or more tracks share a blob (those merged tracks plus the track assigned to it) and
-   all of them are old enough, the blob's cells are split among their predictions by the
+3. blob splitting: a track without a detection, in view for at least ``min_split_age_s``,
+   whose prediction lies within ``split_near_m`` of a blob's cell, has merged with that blob.
+   When two or more tracks share a blob (those merged tracks plus the track assigned to it)
+   and all of them are old enough, the blob's cells are split among their predictions by the
    Voronoi partition and each track takes its part's centroid. Younger tracks are never
-   split, so objects that enter the view merged are tracked as one (the seed's 1 s rule);
+   split, so objects that enter the view merged are tracked as one (the seed's 1 s rule).
+   "In view" (the seed: "only blobs that have been in view for enough frames will be
+   split") is the track's age less the time it spent without a blob of its own (coasting,
+   or fed by a split): a track started on a passing fragment of someone's blob (an arm, the
+   far side seen by a second camera) and then coasting beside that person does not become
+   old by coasting, so it is not kept alive by splitting the person's blob with it (on
+   scene 2 with two cameras such a duplicate lived for 144 of 420 frames when age counted
+   from the track's start);
 4. update the measured tracks; start a track on every detection left over;
 5. a track is confirmed after ``confirm_hits`` measured frames; a track that misses a frame
    before it is confirmed is dropped; a confirmed track coasts on its prediction (output as
@@ -85,6 +92,8 @@ class _Track:
     hits: int
     confirmed: bool
     height: float
+    #: time since its start without a blob of its own (ns): age in view = age - this
+    unseen_ns: int = 0
 
 
 @dataclass(frozen=True)
@@ -139,7 +148,8 @@ class DmtbsTracker:
         if self._last_ns is not None and stamp_ns <= self._last_ns:
             raise ValueError(f"stamp_ns={stamp_ns} must increase (previous frame: {self._last_ns})")
         t0 = time.perf_counter()
-        dt = 0.0 if self._last_ns is None else (stamp_ns - self._last_ns) * 1e-9
+        dt_ns = 0 if self._last_ns is None else stamp_ns - self._last_ns
+        dt = dt_ns * 1e-9
         self._last_ns = stamp_ns
         blobs = [_blob(d) for d in detections]
         if dt > 0.0 and self._tracks:
@@ -148,7 +158,7 @@ class DmtbsTracker:
                 self._x, self._P, F, process_noise(dt, self._cfg.acceleration_variance)
             )
         t1 = time.perf_counter()
-        measurements, used = self._associate(stamp_ns, blobs)
+        measurements, used = self._associate(stamp_ns, dt_ns, blobs)
         t2 = time.perf_counter()
         self._correct(stamp_ns, blobs, measurements, used)
         outputs = self._outputs(stamp_ns)
@@ -160,7 +170,7 @@ class DmtbsTracker:
     # ------------------------------------------------------------------ steps
 
     def _associate(
-        self, stamp_ns: int, blobs: list[_Blob]
+        self, stamp_ns: int, dt_ns: int, blobs: list[_Blob]
     ) -> tuple[dict[int, _Measurement], set[int]]:
         """Track index -> its measurement this frame, and the indices of the blobs used up."""
         cfg = self._cfg
@@ -172,7 +182,10 @@ class DmtbsTracker:
         out = {i: _Measurement(blobs[j].centroid, blobs[j].height) for i, j in pairs}
         used = set(track_of_blob)
         min_age_ns = round(cfg.min_split_age_s * 1e9)
-        old = [stamp_ns - t.created_ns >= min_age_ns for t in self._tracks]
+        old = [stamp_ns - t.created_ns - t.unseen_ns >= min_age_ns for t in self._tracks]
+        for i, t in enumerate(self._tracks):
+            if i not in out:
+                t.unseen_ns += dt_ns
         # Step 3: merged tracks, grouped by the blob their prediction falls on.
         sharing: dict[int, list[int]] = {}
         cells = [b.cells for b in blobs]
