@@ -71,3 +71,23 @@ def test_whole_image_search_finds_both_and_quantised_distances() -> None:
     # 1.02^k grid: 3.0 -> 1.02^55 = 2.972, 3.1 -> 1.02^57 = 3.092
     assert search.quantised(3.0) == pytest.approx(1.02**55)
     assert search.quantised(3.1) == pytest.approx(1.02**57)
+
+
+def test_suppression_keeps_the_best_of_each_overlapping_group() -> None:
+    # Boxes (left, top, w, h): a = (0,0,10,10) 0.9; b = (2,0,10,10) 0.8 overlaps a by
+    # 8*10 / (100 + 100 - 80) = 0.67 > 0.3: dropped; c = (7,0,10,10) 0.7 overlaps a by
+    # 3*10 / 170 = 0.18 and b (dropped, so it does not count) by 0.54: kept; d = (30,0,5,5)
+    # 0.95 overlaps nothing: kept first. Equal scores keep their input order.
+    def m(box: tuple[int, int, int, int], score: float) -> st.Match:
+        return st.Match(box[0] + 5.0, float(box[1]), 3.0, score, 0.0, box)
+
+    a, b, c, d = (
+        m((0, 0, 10, 10), 0.9),
+        m((2, 0, 10, 10), 0.8),
+        m((7, 0, 10, 10), 0.7),
+        m((30, 0, 5, 5), 0.95),
+    )
+    assert search.suppress([a, b, c, d], 0.3) == [d, a, c]
+    assert search.suppress([], 0.3) == []
+    e, f = m((50, 0, 4, 4), 0.5), m((60, 0, 4, 4), 0.5)
+    assert search.suppress([e, f], 0.3) == [e, f]

@@ -79,3 +79,39 @@ def test_a_bare_wall_is_not_a_person() -> None:
     wall = np.full((H, W), 3.0, dtype=np.float32)
     best = st.best_match(wall, st.load_templates(), 3.0, st.F_REF, 0.3, 0.5)
     assert best is not None and best.score < 0.7
+
+
+def test_agreement_without_nan_is_the_same_agreement() -> None:
+    # 1 x 6 depths at D = 2 (band 0.3, gap 0.5): 1.6 is nearer than the band (neither),
+    # 1.8 and 2.3 are on the body (near; the band is inclusive), 2.4 is behind but within
+    # the gap (neither), 2.6 is free (> 2.5), and no depth (NaN; +inf once filled) is free.
+    depth = np.array([[1.6, 1.8, 2.3, 2.4, 2.6, np.nan]], np.float32)
+    near, free = st.agreement_u8(depth, 2.0, 0.3, 0.5)
+    assert near.tolist() == [[0, 255, 255, 0, 0, 0]]
+    assert free.tolist() == [[0, 0, 0, 0, 255, 255]]
+    filled = st.no_depth_far(depth)
+    assert np.isposinf(filled[0, 5]) and not np.isnan(filled).any()
+    near_f, free_f = st.agreement_u8_far(filled, 2.0, 0.3, 0.5)
+    np.testing.assert_array_equal(near_f, near)
+    np.testing.assert_array_equal(free_f, free)
+
+
+@pytest.mark.parametrize("shape", [(30, 40), (96, 128), (192, 256)])
+def test_scores_through_a_shared_spectrum_are_the_direct_scores(shape: tuple[int, int]) -> None:
+    # Random agreement maps, the three templates at 3 m on a quarter-size focal length:
+    # score_all (one DFT of the map, above DFT_MIN_PIXELS) equals matchTemplate + box
+    # filter placement for placement, up to float rounding; a template larger than the
+    # map scores None.
+    rng = np.random.default_rng(3)
+    near = (rng.random(shape) < 0.4).astype(np.uint8) * 255
+    free = ((rng.random(shape) < 0.5) & (near == 0)).astype(np.uint8) * 255
+    maps = st.Agreement.of(near, free, 255.0)
+    templates = [st.scale_template(t, 3.0, st.F_REF / 4) for t in st.load_templates()]
+    huge = st.scale_template(st.load_templates()[0], 0.2, st.F_REF)
+    got = maps.score_all([*templates, huge])
+    assert got[-1] is None
+    for t, scores in zip(templates, got[:-1], strict=True):
+        assert scores is not None
+        direct = maps.score(t)
+        assert scores.shape == direct.shape
+        np.testing.assert_allclose(scores, direct, atol=1e-5)

@@ -37,7 +37,7 @@ def main(argv: list[str]) -> int:
     rig = next(r for r in scenario.rig if r.kind == "stereo_pair")
     pair = StereoPair(StereoPairConfig.model_validate(rig.model_dump()), "odom")
     sim = Simulator(scenario, seed=scenario.seed)
-    matcher = stereo.make_matcher(stereo.SgbmParams(det.num_disparities, det.block_size))
+    matcher = stereo.make_matcher(det.sgbm)
     n_frames = int(scenario.duration_s * scenario.sensor.rate_hz)
     errors: dict[tuple[float, float], list[np.ndarray]] = {b: [] for b in BANDS}
     totals = dict.fromkeys(BANDS, 0)
@@ -55,6 +55,7 @@ def main(argv: list[str]) -> int:
             got = sd.depth[sel & np.isfinite(sd.depth)]
             errors[(lo, hi)].append(np.abs(got - truth[sel & np.isfinite(sd.depth)]))
     print(f"{scenario.name}: SGBM {det.num_disparities} disparities, block {det.block_size}, "
+          f"uniqueness {det.uniqueness_ratio}, speckle window {det.speckle_window}, "
           f"{det.width}x{det.height}")  # fmt: skip
     print("true depth   pixels  coverage  median |err|  p90 |err|  gross (>10%)")
     for (lo, hi), parts in errors.items():

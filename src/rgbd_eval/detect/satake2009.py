@@ -43,6 +43,15 @@ class Satake2009DetectorConfig(ComponentConfig):
     height: int = Field(384, ge=32, le=4096, description="processed height (seed 4: 384)")
     num_disparities: int = Field(32, ge=16, le=512, description="SGBM disparity range (px)")
     block_size: int = Field(5, ge=1, le=21, description="SGBM block size (odd)")
+    uniqueness_ratio: int = Field(
+        10, ge=0, le=100, description="SGBM: best cost beats the second by this % (0: no test)"
+    )
+    speckle_window: int = Field(
+        100,
+        ge=0,
+        le=10000,
+        description="SGBM: disparity blobs smaller than this are dropped (0: off)",
+    )
     template_rows: int = Field(
         16, ge=8, le=512, description="search at the image step where a template is this tall"
     )
@@ -60,7 +69,12 @@ class Satake2009DetectorConfig(ComponentConfig):
     @property
     def sgbm(self) -> stereo.SgbmParams:
         """The SGBM settings."""
-        return stereo.SgbmParams(self.num_disparities, self.block_size)
+        return stereo.SgbmParams(
+            self.num_disparities,
+            self.block_size,
+            uniqueness_ratio=self.uniqueness_ratio,
+            speckle_window=self.speckle_window,
+        )
 
     @property
     def size(self) -> tuple[int, int]:
@@ -76,7 +90,7 @@ class Satake2009DetectorConfig(ComponentConfig):
     def _check(self) -> Satake2009DetectorConfig:
         if self.max_distance_m <= self.min_distance_m:
             raise ValueError("max_distance_m must exceed min_distance_m")
-        stereo.SgbmParams(self.num_disparities, self.block_size)  # ValueError if invalid
+        _ = self.sgbm  # ValueError if invalid
         return self
 
 
@@ -113,12 +127,15 @@ class Satake2009Detector:
         self._scaled: dict[tuple[float, float], list[st.DistanceTemplate]] = {}
         self.last_timings: Mapping[str, float] = {}
 
-    def candidates(self, depth: np.ndarray, fx: float) -> list[st.Match]:
+    def candidates(
+        self, depth: np.ndarray, fx: float, far: np.ndarray | None = None
+    ) -> list[st.Match]:
         """Matches above ``min_score`` at every searched distance, best first, suppressed."""
         c = self.cfg
         found = search.search_whole(
-            depth, fx, self.templates, self.distances, c.template_rows, c.match, cache=self._scaled
-        )
+            depth, fx, self.templates, self.distances, c.template_rows, c.match,
+            cache=self._scaled, far=far,
+        )  # fmt: skip
         return search.suppress(found, c.nms_iou)
 
     def detect(self, frame: Frame) -> list[Detection]:
@@ -127,7 +144,7 @@ class Satake2009Detector:
         sd = search.frame_depth(frame, self.cfg.size, self.cfg.sgbm)
         t1 = time.perf_counter()
         cam, depth = sd.camera, sd.depth
-        matches = self.candidates(depth, cam.fx)
+        matches = self.candidates(depth, cam.fx, sd.far)
         t2 = time.perf_counter()
         c = self.cfg
         rgb = (

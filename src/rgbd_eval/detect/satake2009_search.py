@@ -110,8 +110,11 @@ def level(templates: list[st.DistanceTemplate], distance: float, fx: float, rows
 def _reduced(
     depth: NDArray[np.float32], distance: float, n: int, params: MatchParams
 ) -> st.Agreement:
-    """The agreement maps at ``distance``, averaged over ``n x n`` cells (a partial last cell dropped)."""
-    near, free = st.agreement_u8(depth, distance, params.band_m, params.gap_m)
+    """The agreement maps at ``distance``, averaged over ``n x n`` cells (a partial last cell dropped).
+
+    ``depth`` has no NaN: no depth is +inf (:func:`.satake2009_templates.no_depth_far`).
+    """
+    near, free = st.agreement_u8_far(depth, distance, params.band_m, params.gap_m)
     if n > 1:
         h, w = near.shape
         size = (w // n, h // n)
@@ -124,19 +127,25 @@ def _reduced(
     return st.Agreement.of(near, free, 255.0)
 
 
-def _iou(a: tuple[int, int, int, int], b: tuple[int, int, int, int]) -> float:
-    w = min(a[0] + a[2], b[0] + b[2]) - max(a[0], b[0])
-    h = min(a[1] + a[3], b[1] + b[3]) - max(a[1], b[1])
-    inter = max(0, w) * max(0, h)
-    return inter / float(a[2] * a[3] + b[2] * b[3] - inter)
-
-
 def suppress(matches: list[st.Match], iou: float) -> list[st.Match]:
     """Best first; a match overlapping a kept one by more than ``iou`` is dropped."""
+    if not matches:
+        return []
+    order = np.argsort([-m.score for m in matches], kind="stable")
+    boxes = np.array([matches[i].box for i in order], dtype=np.float64)
+    x0, y0 = boxes[:, 0], boxes[:, 1]
+    x1, y1 = x0 + boxes[:, 2], y0 + boxes[:, 3]
+    area = boxes[:, 2] * boxes[:, 3]
+    alive = np.ones(len(order), dtype=bool)
     kept: list[st.Match] = []
-    for m in sorted(matches, key=lambda m: -m.score):
-        if all(_iou(m.box, k.box) <= iou for k in kept):
-            kept.append(m)
+    for k in range(len(order)):
+        if not alive[k]:
+            continue
+        kept.append(matches[int(order[k])])
+        w = np.minimum(x1[k], x1) - np.maximum(x0[k], x0)
+        h = np.minimum(y1[k], y1) - np.maximum(y0[k], y0)
+        inter = np.maximum(w, 0.0) * np.maximum(h, 0.0)
+        alive &= inter / (area[k] + area - inter) <= iou
     return kept
 
 
@@ -149,24 +158,27 @@ def search_whole(
     params: MatchParams,
     per_template: int = 20,
     cache: dict[tuple[float, float], list[st.DistanceTemplate]] | None = None,
+    far: NDArray[np.float32] | None = None,
 ) -> list[st.Match]:
     """Matches above ``min_score`` anywhere, at each distance, before suppression.
 
-    ``cache`` keeps the scaled templates between calls (the distances are a fixed grid).
+    ``cache`` keeps the scaled templates between calls (the distances are a fixed grid);
+    ``far`` is ``depth`` with NaN as +inf when the caller has it (:attr:`StereoDepth.far`).
     """
     found: list[st.Match] = []
     cache = {} if cache is None else cache
+    filled = st.no_depth_far(depth) if far is None else far
     for D in distances:
         n = level(templates, D, fx, rows)
-        maps = _reduced(depth, D, n, params)
+        maps = _reduced(filled, D, n, params)
         key = (D, fx / n)
         if key not in cache:
             cache[key] = [st.scale_template(t0, D, fx / n) for t0 in templates]
-        for t in cache[key]:
+        usable = [t for t in cache[key] if t.mask.shape[0] >= 8]
+        for t, scores in zip(usable, maps.score_all(usable), strict=True):
+            if scores is None:
+                continue  # larger than the image
             th, tw = t.mask.shape
-            if th > maps.diff.shape[0] or tw > maps.diff.shape[1] or th < 8:
-                continue
-            scores = maps.score(t)
             if cv2.minMaxLoc(scores)[1] < params.min_score:
                 continue  # nothing to collect (the common case: one C pass, no allocation)
             ys, xs = np.nonzero(scores >= params.min_score)
@@ -191,12 +203,14 @@ def search_around(
     rows: int,
     params: MatchParams,
     cache: dict[tuple[float, float], list[st.DistanceTemplate]] | None = None,
+    far: NDArray[np.float32] | None = None,
 ) -> st.Match | None:
     """The best template whose head top lies within ``radius_px`` of ``head`` (None: none fits).
 
     Only the window the templates can cover is scored, so the cost does not grow with
     the image. The winner may score below ``min_score``: the caller decides. ``cache``
-    keeps scaled templates (worth it when the caller quantises the distances).
+    keeps scaled templates (worth it when the caller quantises the distances); ``far``
+    is as for :func:`search_whole`.
     """
     H, W = depth.shape
     u0, v0 = head
@@ -218,7 +232,10 @@ def search_around(
         bottom = min(H, math.ceil(v0 + radius_px + max(t.mask.shape[0] - t.anchor[1] for t in scaled) / k))  # fmt: skip
         if right - left < 2 or bottom - top < 2:
             continue
-        maps = _reduced(depth[top:bottom, left:right], D, n, params)
+        window = (slice(top, bottom), slice(left, right))
+        maps = _reduced(
+            st.no_depth_far(depth[window]) if far is None else far[window], D, n, params
+        )
         for t in scaled:
             th, tw = t.mask.shape
             if th > maps.diff.shape[0] or tw > maps.diff.shape[1]:

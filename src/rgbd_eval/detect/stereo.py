@@ -11,6 +11,7 @@ repeated patterns give no depth (NaN) or wrong depth.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import cv2
 import numpy as np
@@ -133,6 +134,13 @@ class StereoDepth:
 
     depth: NDArray[np.float32]
     camera: CameraModel
+
+    @cached_property
+    def far(self) -> NDArray[np.float32]:
+        """:attr:`depth` with no depth (NaN) as +inf, computed once (the template search's input)."""
+        return np.where(np.isnan(self.depth), np.float32(np.inf), self.depth).astype(
+            np.float32, copy=False
+        )
 
 
 def stereo_depth(

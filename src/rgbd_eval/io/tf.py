@@ -154,6 +154,8 @@ class TfBuffer:
                 )
             return Pose(tuple(trans[k]), tuple(rots[k]))
         t0, t1 = int(stamps[i - 1]), int(stamps[i])
+        if t0 == stamp_ns:  # recorded at this very stamp: as recorded (slerp re-normalises)
+            return Pose(tuple(trans[i - 1]), tuple(rots[i - 1]))
         a = 0.0 if t1 == t0 else (stamp_ns - t0) / (t1 - t0)
         p = trans[i - 1] + a * (trans[i] - trans[i - 1])
         q = slerp(rots[i - 1], rots[i], a)

@@ -348,7 +348,7 @@ def render_markdown(
         f"- |bearing| mean {_m(s.bearing_mean_abs_deg)} deg, max {_m(s.bearing_max_abs_deg)} deg;"
         f" followed track to A's true position: mean {_m(s.track_error_mean_m)} m",
         "",
-        "## Timing (CPU time of the process per frame: one core's work)",
+        "## Timing (CPU time per frame of the detector and tracker alone, OpenCV on one thread: one core's work)",
         "",
         "| | paper (Core2Duo 2.6 GHz) | ours |",
         "|---|---|---|",

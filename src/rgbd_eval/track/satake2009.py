@@ -182,7 +182,7 @@ class Satake2009Tracker:
             t, p = self.tracks[i], heads[i]
             if not p[2] > self.det.min_distance_m * 0.5:
                 continue
-            m = self._search(sd.depth, cam, t, p)
+            m = self._search(sd, cam, t, p)
             if m is None:
                 continue
             D = search.body_distance(sd.depth, m, self.det.band_m)
@@ -209,7 +209,7 @@ class Satake2009Tracker:
         return found, depth_s
 
     def _search(
-        self, depth: np.ndarray, cam: CameraModel, t: _Track, head: ekf.Array
+        self, sd: stereo.StereoDepth, cam: CameraModel, t: _Track, head: ekf.Array
     ) -> st.Match | None:
         """The best template around one track's projected head top, if it scores enough."""
         cfg, D = self.cfg, float(head[2])
@@ -225,8 +225,8 @@ class Satake2009Tracker:
         k = cfg.search_steps
         distances = [search.quantised(D * r**i) for i in range(-k, k + 1)]
         m = search.search_around(
-            depth, cam.fx, self.templates, (u, v), distances, radius, cfg.search_rows,
-            self.det.match, cache=self._scaled,
+            sd.depth, cam.fx, self.templates, (u, v), distances, radius, cfg.search_rows,
+            self.det.match, cache=self._scaled, far=sd.far,
         )  # fmt: skip
         return m if m is not None and m.score >= self.det.min_score else None
 
