@@ -11,9 +11,11 @@ from rgbd_eval.track.colour_moments import (
     MomentWeights,
     moment_distance,
     moment_distances,
+    noise_sigma,
     person_moments,
     person_moments_many,
     region_boxes,
+    reliability,
 )
 
 
@@ -107,3 +109,83 @@ def test_moments_of_many_boxes_equal_one_at_a_time() -> None:
     # the distance of the first person's moments to both: 0 to itself, as moment_distance
     d = moment_distances(regions[0], regions)
     assert d[0] == 0.0 and d[1] == pytest.approx(moment_distance(regions[0], regions[1]))
+
+
+def test_masked_moments_equal_direct_computation_over_the_mask() -> None:
+    rng = np.random.default_rng(1)
+    image = np.clip(rng.exponential(40.0, (40, 50, 3)), 0, 255).astype(np.uint8)
+    mask = rng.random((40, 50)) < 0.4
+    integral = IntegralMoments.of(image, mask, min_count=3)
+    boxes = []
+    for _ in range(40):
+        u0, u1 = sorted(int(x) for x in rng.integers(0, 51, 2))
+        v0, v1 = sorted(int(x) for x in rng.integers(0, 41, 2))
+        boxes.append((u0, v0, u1, v1))
+    many = integral.moments_many(np.array(boxes))
+    for box, got in zip(boxes, many, strict=True):
+        u0, v0, u1, v1 = box
+        p = image[v0:v1, u0:u1][mask[v0:v1, u0:u1]].astype(np.float64)
+        if len(p) < 3:  # too few masked pixels: not measured
+            assert np.isnan(integral.moments(box)).all() and np.isnan(got).all()
+            continue
+        mean = p.mean(axis=0)
+        want = np.stack(
+            [mean, np.sqrt(((p - mean) ** 2).mean(axis=0)), np.cbrt(((p - mean) ** 3).mean(axis=0))]
+        )
+        np.testing.assert_allclose(integral.moments(box), want, atol=1e-6)
+        np.testing.assert_allclose(got, want, atol=1e-6)
+
+
+def test_masked_moments_ignore_the_background_around_a_person() -> None:
+    # a red 2-px-wide "person" on a grey wall, box 6 wide: unmasked the mean is
+    # (2 * 200 + 4 * 100) / 6 = 133.3; over the mask it is the shirt's 200, deviation 0
+    image = np.full((4, 6, 3), 100, dtype=np.uint8)
+    image[:, 2:4, 0] = 200
+    mask = np.zeros((4, 6), dtype=bool)
+    mask[:, 2:4] = True
+    box = (0, 0, 6, 4)
+    assert IntegralMoments.of(image).moments(box)[0, 0] == pytest.approx(400 / 3)
+    np.testing.assert_allclose(IntegralMoments.of(image, mask).moments(box)[:, 0], [200, 0, 0])
+
+
+def test_mask_of_another_shape_is_refused() -> None:
+    with pytest.raises(ValueError, match="mask shape"):
+        IntegralMoments.of(np.zeros((4, 4, 3)), np.zeros((4, 5), dtype=bool))
+
+
+def test_noise_sigma_finds_gaussian_noise_and_ignores_ramps() -> None:
+    rng = np.random.default_rng(2)
+    flat = 100.0 + 6.0 * rng.standard_normal((240, 320, 3))
+    assert noise_sigma(flat) == pytest.approx(6.0, rel=0.05)
+    # a linear ramp has no noise: Immerkaer's mask is zero on planes
+    ramp = np.tile(np.arange(320, dtype=np.float64), (240, 1))
+    assert noise_sigma(ramp) == pytest.approx(0.0, abs=1e-6)
+    assert noise_sigma(np.zeros((2, 2))) == 0.0
+
+
+def test_reliability_of_contrast_against_noise() -> None:
+    # c^2 / (c^2 + (f n)^2): lit, contrast 60 vs noise 2.5 x 3 -> 3600 / (3600 + 56.25) = 0.985;
+    # dark, contrast 3 vs noise 6 x 3 -> 9 / (9 + 324) = 0.027; contrast = 3 noise: 0.5
+    assert reliability(60.0, 2.5, 3.0) == pytest.approx(3600 / 3656.25)
+    assert reliability(3.0, 6.0, 3.0) == pytest.approx(9 / 333)
+    assert reliability(18.0, 6.0, 3.0) == pytest.approx(0.5)
+    assert reliability(0.0, 0.0, 3.0) == 0.0
+
+
+def test_model_contrast_to_the_background() -> None:
+    # two regions, one channel: means 110 and 70 vs background 100 -> (10 + 30) / 2 = 20;
+    # an unmeasured region (NaN) is left out
+    moments = np.array([[[110.0], [5.0], [0.0]], [[70.0], [5.0], [0.0]], [[np.nan]] * 3])
+    assert ColourModel(moments).contrast(np.array([100.0])) == pytest.approx(20.0)
+    assert ColourModel(np.full((1, 3, 1), np.nan)).contrast(np.array([100.0])) == 0.0
+
+
+def test_eight_bit_and_float_integrals_are_the_same_numbers() -> None:
+    # the uint8 path (integral2 and a float32 cube) sums the same integers as float64
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (30, 40, 3)).astype(np.uint8)
+    mask = rng.random((30, 40)) < 0.5
+    for m in (None, mask):
+        a, b = IntegralMoments.of(image, m), IntegralMoments.of(image.astype(np.float64), m)
+        for x, y in ((a.s1, b.s1), (a.s2, b.s2), (a.s3, b.s3)):
+            np.testing.assert_array_equal(x, y)

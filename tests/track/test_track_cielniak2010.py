@@ -148,16 +148,22 @@ def test_sequential_detector_starts_one_filter_per_person_and_deletes_lost_ones(
     assert alive[0] == [1, 2] and alive[-1] == [1]
 
 
-def _dressed_frame(i: int, u: float | None, rgb: tuple[int, int, int]) -> Frame:
+def _dressed_frame(
+    i: int, u: float | None, rgb: tuple[int, int, int], light: float = 1.0, noise: float = 0.0
+) -> Frame:
     """A thermal frame with a person at column ``u`` (none when None) and a colour frame, same
     pose (affine: scale 525 / 300 = 1.75, offset 319.5 - 1.75 * 159.5 = 40.375 and
-    239.5 - 1.75 * 119.5 = 30.375), where the person's thermal box is painted ``rgb``."""
+    239.5 - 1.75 * 119.5 = 30.375), where the person's thermal box is painted ``rgb``; the
+    colour image scaled by ``light`` with Gaussian ``noise`` (levels) added."""
     temp = _people_image([] if u is None else [u])
     colour = np.full((480, 640, 3), 128, np.uint8)
     if u is not None:
         u0, u1 = 1.75 * (u - 20.0) + 40.375, 1.75 * (u + 20.0) + 40.375
         v0, v1 = 1.75 * 80.0 + 30.375, 1.75 * 186.0 + 30.375
         colour[round(v0) : round(v1), round(u0) : round(u1)] = rgb
+    if light != 1.0 or noise > 0.0:
+        dim = light * colour + noise * np.random.default_rng(i).standard_normal(colour.shape)
+        colour = np.clip(np.rint(dim), 0, 255).astype(np.uint8)
     counts = np.rint((temp + 273.15) * 100).astype(np.uint16)
     stamp = i * 33_333_333
     return Frame(
@@ -186,3 +192,45 @@ def test_a_lost_person_is_reidentified_by_colour(
     # red: the same paint in the same body regions, the moments match (below reid_distance): id 1;
     # blue: the means differ by 170 in two channels, far beyond reid_distance: a new id
     assert [t.track_id for t in out] == ([1] if same_id else [2])
+
+
+def test_in_the_dark_colour_is_not_trusted() -> None:
+    """thermal_darkness.yaml's colour camera: light 0.04, noise 6 levels. The red paint is
+    0.04 * 200 = 8 levels on a 0.04 * 128 = 5 background, a contrast of ~3 levels against
+    6 of noise: reliability ~ 9 / (9 + (3 * 6)^2) = 0.03, so colour neither weighs the
+    particles nor re-uses the lost id of a person in other clothes (blue: 0.04 * 170 = 7
+    levels away in two channels, which the raw moment distance would call the same)."""
+    trk = Cielniak2010Tracker(Cielniak2010TrackerConfig(), DetectionContract())
+    lit = Cielniak2010Tracker(Cielniak2010TrackerConfig(), DetectionContract())
+    for i in range(15):
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, 100.0, (200, 30, 30), 0.04, 6.0))
+        lit.update(i * 33_333_333, [], _dressed_frame(i, 100.0, (200, 30, 30), 1.0, 2.5))
+    assert [t.track_id for t in out] == [1]
+    dark_model, lit_model = trk.tracks[0].colour, lit.tracks[0].colour
+    assert dark_model is not None and lit_model is not None
+    # 6 levels of noise, less what clipping at 0 removes around a mean of 5 levels
+    assert 4.0 < trk.noise < 6.5
+    assert trk._reliability(dark_model) < 0.1 < 0.9 < lit._reliability(lit_model)
+    for i in range(15, 30):
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, None, (0, 0, 0), 0.04, 6.0))
+    for i in range(30, 40):
+        out = trk.update(i * 33_333_333, [], _dressed_frame(i, 180.0, (30, 30, 200), 0.04, 6.0))
+    assert [t.track_id for t in out] == [2]
+
+
+def test_same_seed_same_filters_bit_for_bit() -> None:
+    """Particle filters are random: the tracker's own generator, seeded by ``seed``, makes
+    two runs on the same frames equal to the last bit (colour on, noisy image); another
+    seed moves the particles (the reported box may still be the warm component's)."""
+
+    def run(seed: int) -> list[bytes]:
+        trk = Cielniak2010Tracker(Cielniak2010TrackerConfig(seed=seed), DetectionContract())
+        out = []
+        for i in range(12):
+            frame = _dressed_frame(i, 100.0 + 2.0 * i, (200, 30, 30), 1.0, 2.5)
+            trk.update(i * 33_333_333, [], frame)
+            out.append(b"".join(t.filter.particles.tobytes() for t in trk.tracks))
+        return out
+
+    first = run(0)
+    assert first[-1] and first == run(0) and first[-1] != run(1)[-1]

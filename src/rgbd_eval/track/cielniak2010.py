@@ -15,20 +15,27 @@ Per frame:
    our addition), minus the distance of the colour moments of its head, torso and legs
    to the person's adaptive colour model over ``colour_scale`` (section 4; the colour
    image is aligned by the affine map below), with the interaction ``rho`` towards the
-   other filters' estimates. A filter behind another one (section 6: pairwise
+   other filters' estimates. The moments are of the person's own pixels: the warm pixels
+   of the thermal image mapped onto the colour image (``colour_mask``). The colour term is
+   weighted by the person's colour reliability, its contrast to the image's mean colour
+   against the image noise (:func:`rgbd_eval.track.colour_moments.reliability`): about 1
+   in the light, about 0 in the dark, where colour would otherwise mislead. A filter
+   behind another one (section 6: pairwise
    :func:`rgbd_eval.track.occlusion.order`, overlap of the boxes at least
    ``occlusion_overlap``) coasts on its motion model, and neither penalises nor is
    penalised by the others, for at most ``max_occluded_frames``.
 2. A filter whose estimate scores below ``stop_score`` for ``lost_frames`` frames in a
    row, or whose centre leaves the image, is deleted; its colour model is remembered
    ``reid_memory_frames`` for re-identification (section 6). The colour model of a filter
-   seen clearly (score at least ``start_score``, no overlap) adapts at rate ``colour_alpha``.
+   seen clearly (score at least ``start_score``, its box overlapping no other filter's)
+   adapts at rate ``colour_alpha``.
 3. The sequential detector proposes person-shaped warm regions
    (:mod:`rgbd_eval.track.warm_regions`) away from the tracked persons; a proposal that
    scores at least ``start_score`` and implies a standing height within the prior's
    range, and is seen again (IoU >= 0.3) in ``confirm_frames`` consecutive frames,
-   starts a filter, with the id of a remembered person whose colour moments lie within
-   ``reid_distance``, else a new one.
+   starts a filter, with the id of the nearest remembered person whose colour moments lie
+   within ``reid_distance``, when the new person's colour reliability is at least
+   ``reid_min_reliability``; else a new one.
 
 Boxes are mapped from the thermal to the colour image, where the ground truth lives, by
 the affine transform of parallel cameras at a nominal depth (seed 004, section 4.1: the
@@ -44,6 +51,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
@@ -54,7 +62,9 @@ from rgbd_eval.track.colour_moments import (
     ColourModel,
     IntegralMoments,
     moment_distances,
+    noise_sigma,
     person_moments_many,
+    reliability,
 )
 from rgbd_eval.track.occlusion import order, overlap
 from rgbd_eval.track.person_geometry import HeightPrior, height_log_prior, implied_heights
@@ -110,9 +120,17 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     occlusion_overlap: float = Field(0.3, gt=0.0, le=1.0, description="over the smaller box")
     max_occluded_frames: int = Field(60, ge=1, description="an occluded filter coasts this long")
     colour: bool = Field(True, description="section 4: colour moments in the likelihood")
-    colour_scale: float = Field(20.0, gt=0.0, description="moment distance per log-likelihood")
+    colour_scale: float = Field(10.0, gt=0.0, description="moment distance per log-likelihood")
     colour_alpha: float = Field(0.05, ge=0.0, le=1.0, description="adaptive update rate")
     colour_stride: int = Field(2, ge=1, le=16, description="colour image subsampling")
+    colour_noise_factor: float = Field(
+        3.0, gt=0.0, description="contrast this many noise sigmas gives colour half weight"
+    )
+    reid_min_reliability: float = Field(
+        0.5, ge=0.0, le=1.0, description="colour trust to re-use an id"
+    )
+    colour_mask: bool = Field(True, description="moments of the warm (person) pixels only")
+    colour_min_pixels: int = Field(4, ge=1, description="fewer masked pixels: region unmeasured")
     reid_distance: float = Field(
         40.0, ge=0.0, description="section 6: moment distance to re-use an id"
     )
@@ -139,6 +157,17 @@ class Affine:
             (sx, sy),
             (c.cx - sx * t.cx + c.fx * bx / depth_m, c.cy - sy * t.cy + c.fy * by / depth_m),
         )
+
+    def warp(
+        self, mask: NDArray[np.bool_], shape: tuple[int, int], stride: int
+    ) -> NDArray[np.bool_]:
+        """A thermal-image mask on the colour image subsampled by ``stride`` (``shape``)."""
+        (sx, sy), (ox, oy) = self.scale, self.offset
+        m = np.array([[sx / stride, 0.0, ox / stride], [0.0, sy / stride, oy / stride]])
+        out = cv2.warpAffine(
+            mask.astype(np.uint8), m, (shape[1], shape[0]), flags=cv2.INTER_NEAREST
+        )
+        return np.asarray(out, dtype=bool)
 
     def box(self, u0: float, v0: float, u1: float, v1: float) -> Box2D:
         (sx, sy), (ox, oy) = self.scale, self.offset
@@ -214,6 +243,8 @@ class Cielniak2010Tracker:
         self.lost: list[_Lost] = []
         self.frame_index = 0
         self.integral: IntegralMoments | None = None
+        self.noise = 0.0
+        self.background: F64 = np.zeros(3)
         self.next_id = 1
         self.last_stamp: int | None = None
         self.affine: Affine | None = None
@@ -233,7 +264,13 @@ class Cielniak2010Tracker:
         self.integral = None
         if self.cfg.colour and colour is not None and colour.image.ndim == 3:
             k = self.cfg.colour_stride
-            self.integral = IntegralMoments.of(colour.image[::k, ::k])
+            image = np.ascontiguousarray(colour.image[::k, ::k])
+            mask = None
+            if self.cfg.colour_mask and self.affine is not None:
+                mask = self.affine.warp(self._warm_mask(temp), image.shape[:2], k)
+            self.integral = IntegralMoments.of(image, mask, self.cfg.colour_min_pixels)
+            self.noise = noise_sigma(image)
+            self.background = image.reshape(-1, image.shape[2]).mean(axis=0)
         self.frame_index += 1
         dt = 1.0 / 30.0 if self.last_stamp is None else max(stamp_ns - self.last_stamp, 0) / 1e9
         self.last_stamp = stamp_ns
@@ -252,6 +289,14 @@ class Cielniak2010Tracker:
         }
         return out
 
+    def _warm_mask(self, temp: NDArray[np.float32]) -> NDArray[np.bool_]:
+        """Pixels in the band of human surface temperature (as :func:`warm_regions`)."""
+        room = float(np.median(temp))
+        out: NDArray[np.bool_] = (temp > room + self.cfg.warm_contrast_k) & (
+            temp < self.cfg.warm_max_c
+        )
+        return out
+
     def _observe(self, states: F64) -> F64:
         """``(N, R, 3, C)`` colour moments of the body regions of N states (section 4)."""
         if self.integral is None or self.affine is None:
@@ -265,6 +310,13 @@ class Cielniak2010Tracker:
             axis=1,
         )  # fmt: skip
         return person_moments_many(self.integral, colour_boxes)
+
+    def _reliability(self, model: ColourModel) -> float:
+        """How far this person's colour can be trusted now: its contrast to the image's mean
+        colour against the image noise (:func:`reliability`); ~1 in the light, ~0 in the dark."""
+        return reliability(
+            model.contrast(self.background), self.noise, self.cfg.colour_noise_factor
+        )
 
     def _colour_distances(self, model: ColourModel, states: F64) -> F64:
         d = moment_distances(model.moments, self._observe(states))
@@ -288,7 +340,8 @@ class Cielniak2010Tracker:
             heights = implied_heights(thermal.camera, thermal.pose, states)
             ll = ll + height_log_prior(self.height_prior, heights)
         if model is not None and self.integral is not None:
-            ll = ll - self._colour_distances(model, states) / self.cfg.colour_scale
+            weight = self._reliability(model) / self.cfg.colour_scale
+            ll = ll - weight * self._colour_distances(model, states)
         return ll
 
     def _occluded(self, temp: NDArray[np.float32], colour: Stream | None) -> set[int]:
@@ -361,11 +414,7 @@ class Cielniak2010Tracker:
         for i, t in enumerate(self.tracks):
             if t.occluded_frames or t.score < self.cfg.start_score:
                 continue
-            if any(
-                overlap(boxes[i], b) >= self.cfg.occlusion_overlap
-                for j, b in enumerate(boxes)
-                if j != i
-            ):
+            if any(overlap(boxes[i], b) > 0.0 for j, b in enumerate(boxes) if j != i):
                 continue
             seen = self._observe(t.filter.estimate[None, :])[0]
             t.colour = (
@@ -429,7 +478,7 @@ class Cielniak2010Tracker:
         if self.integral is not None:
             seen = self._observe(state[None, :])
             model = ColourModel(seen[0])
-            if self.lost:
+            if self.lost and self._reliability(model) >= self.cfg.reid_min_reliability:
                 d = [float(moment_distances(lost.colour.moments, seen)[0]) for lost in self.lost]
                 best = int(np.argmin(d))
                 if d[best] <= self.cfg.reid_distance:
