@@ -49,7 +49,7 @@ class ResumableDetector(Detector, Protocol):
     fresh detector B fed frames ``0..k-1`` with :meth:`advance`, then
     ``C.restore_state(B.carry_state())`` on a fresh C fed frames ``k..n-1`` with
     :meth:`detect`, C returns the very detections A returned for those frames, bit
-    for bit (tests/detect/test_resumable.py checks basso2012). It may also declare
+    for bit (tests/test_chunked.py checks basso2012). It may also declare
     ``advance_cost``, :meth:`advance`'s time per frame as a fraction of :meth:`detect`'s,
     to balance the chunks of a split detection (:func:`rgbd_eval.chunked.advance_cost`).
     """
