@@ -217,6 +217,24 @@ def test_recording_digest_is_memoised_by_file_identity(
     assert texts == {"not a digest\n", hashlib.sha256(b"abcd").hexdigest() + "\n"}
 
 
+def test_known_digest_reads_only_the_memo(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    recording = tmp_path / "rec.mcap"
+    recording.write_bytes(b"abc")
+    cache = DetectionCache(tmp_path / "cache")
+
+    def no_hashing(path: Path) -> str:
+        raise AssertionError(f"{path} hashed")
+
+    monkeypatch.setattr("rgbd_eval.cache.file_digest", no_hashing)
+    assert cache.known_digest(recording) is None  # no memo yet, and nothing hashed
+    assert cache.known_digest(tmp_path / "missing.mcap") is None
+    monkeypatch.undo()
+    digest = cache.digest(recording)
+    assert cache.known_digest(recording) == digest
+    recording.write_bytes(b"abcd")  # other files now: the old memo does not apply
+    assert cache.known_digest(recording) is None
+
+
 def test_digest_of_a_missing_recording_is_an_os_error(tmp_path: Path) -> None:
     with pytest.raises(FileNotFoundError):
         DetectionCache(tmp_path / "cache").digest(tmp_path / "missing.mcap")

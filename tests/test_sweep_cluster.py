@@ -140,6 +140,36 @@ def test_default_split_of_one_recording(
     assert set(client2.run(os.environ.get, "MALLOC_TRIM_THRESHOLD_").values()) == {None}
 
 
+def test_a_warm_sweep_submits_no_chunks_and_a_corrupt_entry_is_detected_in_one_pass(
+    recordings: list[Path], reference: SweepResult, client2: Any, tmp_path: Path
+) -> None:
+    """The client finds the entries by the memoised digests: a warm sweep submits no chunk
+    tasks. An entry that fails its checksum is still recomputed (by the prepare task, in
+    one pass), with the same records."""
+    from distributed import get_task_stream
+
+    grid, configs = grid_and_configs()
+    plan = ChunkPlan(3, 3)
+    with get_task_stream(client2) as cold_ts:
+        cold = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
+    with get_task_stream(client2) as warm_ts:
+        warm = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
+
+    def chunk_tasks(stream: Any) -> int:
+        return sum(str(t["key"]).startswith("_detect_chunk") for t in stream.data)
+
+    assert (cold.cache_misses, warm.cache_hits) == (2, 2)
+    assert chunk_tasks(cold_ts) == 6 and chunk_tasks(warm_ts) == 0  # 3 chunks x 2 recordings
+    entry = DetectionCache(tmp_path).path(detection_key(file_digest(recordings[0]), configs[0]))
+    blob = bytearray(entry.read_bytes())
+    blob[len(blob) // 2] ^= 0x04
+    entry.write_bytes(bytes(blob))
+    again = run_sweep(recordings, grid, configs, client2, cache_root=tmp_path, chunks=plan)
+    assert (again.cache_hits, again.cache_misses) == (1, 1)
+    assert any("checksum mismatch" in w for w in again.warnings)
+    assert records(cold) == records(warm) == records(again) == records(reference)
+
+
 def test_a_bad_recording_fails_alike_in_chunks(client2: Any, tmp_path: Path) -> None:
     bad = tmp_path / "broken.mcap"
     bad.write_bytes(b"\x89MCAP0\r\n" + b"\x00" * 64)  # magic, then nothing readable

@@ -255,18 +255,29 @@ class DetectionCache:
         if self.root.exists() and not self.root.is_dir():
             raise CacheError(self.root, "is a file, not a detection cache folder")
 
+    def _memo(self, recording: Path) -> Path:
+        identity = json.dumps(_stat_identity(recording.resolve())).encode()
+        return self.root / "digests" / f"{hashlib.sha256(identity).hexdigest()}.sha256"
+
+    def known_digest(self, recording: Path) -> str | None:
+        """The memoised digest of ``recording`` (see :meth:`digest`), or None when there is
+        no valid memo for its current files; never reads the recording itself."""
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            text = self._memo(recording).read_text(encoding="ascii").strip()
+            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
+                return text
+        return None
+
     def digest(self, recording: Path) -> str:
         """The recording's :func:`~rgbd_eval.report.file_digest`, memoised under ``digests/``
         by the files' (path, size, mtime_ns, ctime_ns, inode, device): a warm sweep does
         not read every recording again. A memo that does not parse is recomputed; OSError
         when the recording cannot be read."""
         recording = recording.resolve()
-        identity = json.dumps(_stat_identity(recording)).encode()
-        memo = self.root / "digests" / f"{hashlib.sha256(identity).hexdigest()}.sha256"
-        with contextlib.suppress(OSError, UnicodeDecodeError):
-            text = memo.read_text(encoding="ascii").strip()
-            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
-                return text
+        known = self.known_digest(recording)
+        if known is not None:
+            return known
+        memo = self._memo(recording)
         digest = file_digest(recording)
         tmp = memo.with_name(f".{memo.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
         try:  # a memo that cannot be written costs a re-hash next time, nothing else

@@ -528,6 +528,12 @@ def run_sweep(
             rejected += [str(w.message) for w in caught if issubclass(w.category, CacheWarning)]
         plan = chunks or ChunkPlan(slots_per_group)
         split = plan.chunks > 1 and cached is None and resumable(cfg)
+        if split and not client_side:
+            # A warm sweep needs no chunk tasks: they would only wait for the opened
+            # recording and pass. Looked up by the memoised digest alone (no hashing); an
+            # entry that then fails its checksum is detected in one pass by the prepare task.
+            known = cache.known_digest(path)
+            split = known is None or not cache.path(detection_key(known, cfg)).is_file()
         if split and chunks is None:
             # Chunks shorter where they wait longer for the detector's state.
             plan = replace(plan, advance_cost=advance_cost(cfg))
