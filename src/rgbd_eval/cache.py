@@ -256,17 +256,27 @@ class DetectionCache:
             raise CacheError(self.root, "is a file, not a detection cache folder")
 
     def _memo(self, recording: Path) -> Path:
+        """Where the digest of ``recording``'s current files is memoised; OSError if unreadable."""
         identity = json.dumps(_stat_identity(recording.resolve())).encode()
         return self.root / "digests" / f"{hashlib.sha256(identity).hexdigest()}.sha256"
+
+    @staticmethod
+    def _read_memo(memo: Path) -> str | None:
+        """The digest a memo holds, or None when it is missing or does not hold one."""
+        with contextlib.suppress(OSError, UnicodeDecodeError):
+            text = memo.read_text(encoding="ascii").strip()
+            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
+                return text
+        return None
 
     def known_digest(self, recording: Path) -> str | None:
         """The memoised digest of ``recording`` (see :meth:`digest`), or None when there is
         no valid memo for its current files; never reads the recording itself."""
-        with contextlib.suppress(OSError, UnicodeDecodeError):
-            text = self._memo(recording).read_text(encoding="ascii").strip()
-            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
-                return text
-        return None
+        try:
+            memo = self._memo(recording)
+        except OSError:
+            return None
+        return self._read_memo(memo)
 
     def digest(self, recording: Path) -> str:
         """The recording's :func:`~rgbd_eval.report.file_digest`, memoised under ``digests/``
@@ -274,10 +284,10 @@ class DetectionCache:
         not read every recording again. A memo that does not parse is recomputed; OSError
         when the recording cannot be read."""
         recording = recording.resolve()
-        known = self.known_digest(recording)
+        memo = self._memo(recording)
+        known = self._read_memo(memo)
         if known is not None:
             return known
-        memo = self._memo(recording)
         digest = file_digest(recording)
         tmp = memo.with_name(f".{memo.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
         try:  # a memo that cannot be written costs a re-hash next time, nothing else
