@@ -8,8 +8,7 @@ import numpy as np
 import pytest
 
 from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
-from rgbd_eval.methods.dmtbs import check_claims
-from rgbd_eval.methods.dmtbs_experiments import (
+from rgbd_eval.experiments.dmtbs import (
     arc_camera,
     left_object,
     left_object_frames,
@@ -17,6 +16,7 @@ from rgbd_eval.methods.dmtbs_experiments import (
     with_noise,
     yaw_error,
 )
+from rgbd_eval.methods.dmtbs import check_claims
 from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.tof import TofFrame, TofImage
@@ -206,7 +206,7 @@ def _walker_scene() -> Scenario:
 
 
 def test_camera_angle_pools_the_runs_of_each_angle() -> None:
-    from rgbd_eval.methods.dmtbs_experiments import camera_angle
+    from rgbd_eval.experiments.dmtbs import camera_angle
 
     scene = _walker_scene()
     det = DmtbsDetectorConfig(init_frames=10, roi=(-2, -2, 2, 2), min_blob_area_m2=0.0)

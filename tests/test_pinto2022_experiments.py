@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from rgbd_eval.datasets import scenarios_dir
+from rgbd_eval.experiments.pinto2022 import check_claims, render, trinet_to_units
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
-from rgbd_eval.methods.pinto2022_experiments import check_claims, render, trinet_to_units
 from rgbd_eval.plugins import ReproduceResult
 from rgbd_eval.report_html import reproduce_page
 from rgbd_eval.report_html.pages import paper_file

@@ -97,3 +97,22 @@ def test_unknown_method_exits_4_naming_the_known_ones(tmp_path: Path) -> None:
     known = ", ".join(sorted({*plugins.known("methods"), "toy"}))
     assert res.stderr.strip().splitlines() == [f"error: unknown method 'nonesuch' (known: {known})"]
     assert not (tmp_path / "runs").exists()
+
+
+def test_discovery_loads_no_simulator() -> None:
+    """Every CLI call and Dask worker runs plug-in discovery; it must not pull in the renderer.
+
+    ``rgbd_eval.experiments`` (reproduce only) is outside the scanned packages; importing
+    ``rgbd_eval.sim`` there cost every call ~1.3 CPU s of open3d before it moved.
+    """
+    code = (
+        "import sys\n"
+        "from rgbd_eval import plugins\n"
+        "plugins.load_plugins()\n"
+        "assert len(plugins.known('methods')) >= 5, plugins.known('methods')\n"
+        "print(sorted(m for m in ('open3d', 'rgbd_eval.sim', 'scipy.stats') if m in sys.modules))\n"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120
+    )
+    assert out.stdout.strip() == "[]", out.stdout + out.stderr

@@ -36,7 +36,7 @@ register_method(
 
 
 def _run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
-    from rgbd_eval.methods.cielniak2010_experiments import run
+    from rgbd_eval.experiments.cielniak2010 import run
 
     return run(recordings, options)
 

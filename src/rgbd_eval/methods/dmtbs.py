@@ -63,7 +63,7 @@ YAW_ERRORS_DEG = [0.0, 0.5, 1.0, 1.5, 2.0, 3.0]
 
 def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
     from rgbd_eval.config import config_dir, load_config
-    from rgbd_eval.methods.dmtbs_experiments import (
+    from rgbd_eval.experiments.dmtbs import (
         calibration_error,
         camera_angle,
         camera_count,

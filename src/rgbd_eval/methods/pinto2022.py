@@ -45,7 +45,7 @@ def _scenario(name: str) -> str:
 
 
 def _run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
-    from rgbd_eval.methods.pinto2022_experiments import run
+    from rgbd_eval.experiments.pinto2022 import run
 
     return run(recordings, options)
 

@@ -28,7 +28,7 @@ register_method(
 
 
 def _reproduce(_recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
-    from rgbd_eval.methods.satake2009_experiments import run
+    from rgbd_eval.experiments.satake2009 import run
 
     return run(options)
 

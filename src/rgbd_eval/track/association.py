@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
-from scipy.stats import chi2
+from scipy.special import gammaincinv
 
 Array = NDArray[np.float64]
 Pairs = list[tuple[int, int]]
@@ -23,7 +23,8 @@ def chi_square_gate(probability: float, dof: int = 2) -> float:
         raise ValueError(f"gate probability={probability} must be in (0, 1)")
     if dof < 1:
         raise ValueError(f"dof={dof} must be >= 1")
-    return float(chi2.ppf(probability, dof))
+    # scipy.stats.chi2.ppf's own formula, without importing scipy.stats (0.4 s at start-up).
+    return float(2.0 * gammaincinv(dof / 2.0, probability))
 
 
 def mahalanobis_sq(z_pred: Array, Pzz: Array, z: Array, r: Array) -> Array:

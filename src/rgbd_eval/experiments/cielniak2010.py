@@ -152,8 +152,8 @@ def summarise_ablation(
 
 def classifier_groups(classifier: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     """Held-out accuracy per feature group of the shipped classifiers, in light and darkness."""
+    from rgbd_eval.experiments.occlusion_training import evaluate, render_features
     from rgbd_eval.track.occlusion import load_classifiers
-    from rgbd_eval.track.occlusion_training import evaluate, render_features
 
     models = load_classifiers()
     seed, pairs, jitter = (
