@@ -175,3 +175,23 @@ def test_mog2_keeps_the_background_of_pixels_with_dropouts() -> None:
     for k in range(50, 60):
         fg = bg.apply(wall(k), 1 / 30)
         assert not fg.any()
+
+
+def test_no_return_for_init_frames_in_a_row_makes_the_background_infinitely_far() -> None:
+    bg = RunningAverageBackground(init_frames=2, time_constant_s=HALF_TAU, margin_m=0.1)
+    # Initialisation: a person walks through a pixel that otherwise sees nothing (sky):
+    # p0 mean of its one valid sample = 4.4, a phantom. p1 the same, for the interrupted case.
+    bg.apply(_row(4.4, 4.4), 0.1)
+    bg.apply(_row(NAN, NAN), 0.1)
+    assert bg.background is not None
+    np.testing.assert_allclose(bg.background, _row(4.4, 4.4), rtol=1e-6)
+    # p0: no return once (of 2); p1: no return once, then a return at the phantom's depth
+    # (not farther than 4.4 by > 0.1: the streak ends), then no return once again.
+    assert not bg.apply(_row(NAN, NAN), 0.1).any()
+    assert not bg.apply(_row(NAN, 4.4), 0.1).any()
+    np.testing.assert_allclose(bg.background, _row(np.inf, 4.4), rtol=1e-6)  # p0: 2 in a row
+    assert not bg.apply(_row(NAN, NAN), 0.1).any()
+    np.testing.assert_allclose(bg.background, _row(np.inf, 4.4), rtol=1e-6)  # p1: 1 of 2
+    # A person passing behind the old phantom (5.9 m > 4.4 m) is now foreground at p0; at p1
+    # it is still hidden behind the phantom (farther: background, the revealed-surface count).
+    np.testing.assert_array_equal(bg.apply(_row(5.9, 5.9), 0.1), [[True, False]])

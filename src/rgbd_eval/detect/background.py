@@ -9,7 +9,14 @@ implemented here, stated once:
 - Initialisation (the first ``init_frames`` frames): the background is the mean of each
   pixel's valid samples. A pixel never valid during it (beyond range, a window, the sky) gets
   an infinitely far background, so whatever later appears there is foreground.
-- After it, an invalid pixel leaves its background unchanged (it carries no information).
+- After it, an invalid pixel leaves the weighted average unchanged (it carries no depth).
+  But where a finite background has given no return for ``init_frames`` frames in a row,
+  the background becomes infinitely far: no return is the farthest a pixel can be, and this
+  is the revealed-surface rule below with no surface behind. Without it a pixel that looks
+  at nothing (the sky, beyond range) keeps as background whoever walked through it while the
+  background was learnt (the mean of its few valid samples), and a person later passing
+  behind that phantom is never foreground: at Fig. 8's level camera, one person of three
+  was lost for 2-3 s per pass that way.
 - A valid pixel ``z`` first enters the weighted average ``B <- (1 - a) B + a z`` with
   ``a = 1 - exp(-dt / tau)`` (a time constant, so the behaviour does not depend on the frame
   rate); then, where ``z`` has lain farther than ``B`` by more than the margin for
@@ -134,14 +141,23 @@ def _running_average_step(
     """One frame of the running average on flat images, in place (rules: module docstring)."""
     for i in range(z.shape[0]):
         zi = z[i]
-        if not math.isfinite(zi):  # invalid: no information, background kept
-            foreground[i] = False
-            streak[i] = 0
-            continue
         b = B[i]
+        # streak > 0: frames in a row farther than B (or valid, if B is infinitely far);
+        # streak < 0: frames in a row without a return while B is finite.
+        if not math.isfinite(zi):  # invalid: no depth, the average is kept
+            foreground[i] = False
+            if math.isinf(b):
+                streak[i] = 0
+                continue
+            s = min(streak[i], 0) - 1
+            if -s >= init_frames:  # no return for long: nothing there, B infinitely far
+                B[i] = math.inf
+                s = 0
+            streak[i] = s
+            continue
         if math.isinf(b):  # never-seen background: foreground, adopted after a streak
             foreground[i] = True
-            s = streak[i] + 1
+            s = max(streak[i], 0) + 1
             if s >= init_frames:
                 B[i] = zi
                 s = 0
@@ -150,7 +166,7 @@ def _running_average_step(
         foreground[i] = b - zi > margin
         b = b + alpha * (zi - b)  # step 1: weighted average
         if zi - b > margin:  # step 2: a farther surface, revealed once seen long enough
-            s = streak[i] + 1
+            s = max(streak[i], 0) + 1
             if s >= init_frames:
                 b = zi
                 s = 0
