@@ -47,7 +47,8 @@ def test_chunk_0_needs_no_advance_and_each_chunk_its_link() -> None:
     client = RecordingClient()
     opened = Submitted(print, (), "_prepare-x")
     plan = ChunkPlan(3, 1, 0.28)
-    joined: Any = _submit_chunks(client, Path("r.mcap"), opened, config(), plan, None)  # type: ignore[arg-type]
+    slots = ["tcp://a:1", "tcp://b:1", "tcp://c:1"]
+    joined: Any = _submit_chunks(client, Path("r.mcap"), opened, config(), plan, None, slots)  # type: ignore[arg-type]
     futures = [f for f, _ in client.calls]
     # Submission order: the advance chain (2 links), the 3 chunks, the join.
     assert [f.func for f in futures] == [_advance] * 2 + [_detect_chunk] * 3 + [_join]
@@ -56,12 +57,9 @@ def test_chunk_0_needs_no_advance_and_each_chunk_its_link() -> None:
     assert adv0.args[3:] == (0, None) and adv1.args[3:] == (1, adv0)
     assert chunk0.args[3:] == (0, None)  # ready as soon as the recording is open
     assert chunk1.args[3:] == (1, adv0) and chunk2.args[3:] == (2, adv1)
-    assert all(f.args[0] is opened and f.args[2] == plan for f in futures[:5])
-    # Chunk 0's config is the one input every worker holds (scattered to all), so that any
-    # worker may take it; the others get the config itself.
-    assert client.scattered == [(config(), {"broadcast": True, "hash": False})]
-    assert chunk0.args[1] == Submitted(client.scatter, (config(),), "scattered-1")
-    assert chunk1.args[1] == config() == adv0.args[1]
+    assert all(f.args[0] is opened for f in futures[:5])
+    assert all(f.args[1] == config() for f in futures[:5])
+    assert all(f.args[2] == plan for f in futures[:5])
     assert join is joined and join.args[4:] == (chunk0, chunk1, chunk2)
     # Keys name the task and its chunk; every submission starts its own priority generation.
     assert [f.key.rsplit("-", 1)[0] for f in futures[:5]] == [
@@ -72,6 +70,26 @@ def test_chunk_0_needs_no_advance_and_each_chunk_its_link() -> None:
         "_detect_chunk-2",
     ]
     assert len({f.key for f in futures}) == 6
+    # Placement, loose: the advance chain on the first slot (the prepare task's), chunk k on
+    # slot k + 1, so chunk 0 starts at once elsewhere and the last chunk follows the chain.
+    loose = {"fifo_timeout": 0, "allow_other_workers": True}
+    options = [o for _, o in client.calls]
+    assert options[:5] == [
+        {**loose, "workers": ["tcp://a:1"]},
+        {**loose, "workers": ["tcp://a:1"]},
+        {**loose, "workers": ["tcp://b:1"]},
+        {**loose, "workers": ["tcp://c:1"]},
+        {**loose, "workers": ["tcp://a:1"]},
+    ]
+    assert options[5] == {"fifo_timeout": 0}  # the join: wherever its inputs are
+
+
+def test_chunks_without_known_workers_are_not_placed() -> None:
+    client = RecordingClient()
+    plan = ChunkPlan(2, 1, 0.28)
+    _submit_chunks(
+        client, Path("r.mcap"), Submitted(print, (), "p"), config(), plan, None, [None, None]
+    )  # type: ignore[arg-type]
     assert all(options == {"fifo_timeout": 0} for _, options in client.calls)
 
 

@@ -56,7 +56,14 @@ from rgbd_eval.chunked import (
 )
 from rgbd_eval.config import RunConfig, build_config, parse_overrides
 from rgbd_eval.engine import ClusterSpec, connect, killed_worker_message
-from rgbd_eval.errors import ClusterError, ConfigError, InputError, RgbdEvalError, ScoringError
+from rgbd_eval.errors import (
+    CacheError,
+    ClusterError,
+    ConfigError,
+    InputError,
+    RgbdEvalError,
+    ScoringError,
+)
 from rgbd_eval.io.groundtruth import GroundTruth
 from rgbd_eval.io.reader import Recording
 from rgbd_eval.metrics import Counts, summarize, total
@@ -214,6 +221,31 @@ class _Prepared:
 
 
 @dataclass(frozen=True)
+class _Stored:
+    """A prepare result whose detections are in the shared cache, without them: what the
+    track and score tasks receive, so that a worker loads the entry (checksummed) instead of
+    receiving the detections from the worker that made them (:func:`_stored`)."""
+
+    path: Path
+    key: str
+    cache_root: Path
+    ground_truth: GroundTruthMatch
+
+
+#: Detections a worker process made or loaded, by cache key: the last few, so that the
+#: track tasks of one recording read its cache entry once per worker (see :func:`_stored`).
+_LOCAL_DETECTIONS: dict[str, SequenceDetections] = {}
+_LOCAL_KEEP = 2
+
+
+def _keep_local(key: str, detections: SequenceDetections) -> None:
+    _LOCAL_DETECTIONS.pop(key, None)
+    _LOCAL_DETECTIONS[key] = detections
+    while len(_LOCAL_DETECTIONS) > _LOCAL_KEEP:
+        del _LOCAL_DETECTIONS[next(iter(_LOCAL_DETECTIONS))]
+
+
+@dataclass(frozen=True)
 class _Opened:
     """A cache miss to detect in chunks: the recording, opened once for its chunk tasks."""
 
@@ -289,6 +321,7 @@ def _prepare(
         matched = match_ground_truth(gt, detections.stamps_ns, config)
     except RgbdEvalError as err:
         return _failed(err)
+    _keep_local(key, detections)
     return _Prepared(path, key, detections, matched, time.perf_counter() - start, hit, rejected)
 
 
@@ -358,7 +391,43 @@ def _join(
     except RgbdEvalError as err:
         return _failed(err)
     seconds = opened.seconds + sum(t for _, t in chunks) + time.perf_counter() - start
+    _keep_local(key, detections)
     return _Prepared(path, key, detections, matched, seconds, False, opened.rejected)
+
+
+def _stored(prepared: _Prepared | _Failed, cache_root: Path) -> _Prepared | _Stored | _Failed:
+    """``prepared`` without its detections when they are in the shared cache, else as is.
+
+    Runs where ``prepared`` is. The track tasks then depend on this small record alone, so
+    the scheduler places them freely and no worker receives 4.4 MB of detections from
+    another (0.1-0.35 s on moving_complex, while the sender computes, and traffic that
+    grows with the cluster); each worker loads the entry once instead (0.04 s).
+    """
+    if not isinstance(prepared, _Prepared):
+        return prepared
+    if not DetectionCache(cache_root).path(prepared.key).is_file():
+        return prepared  # not stored (it could not be written): the detections travel
+    return _Stored(prepared.path, prepared.key, cache_root, prepared.ground_truth)
+
+
+def _detections_of(prepared: _Prepared | _Stored) -> SequenceDetections:
+    """The detections of a prepare result, loaded from the shared cache when not at hand."""
+    if isinstance(prepared, _Prepared):
+        return prepared.detections
+    local = _LOCAL_DETECTIONS.get(prepared.key)
+    if local is not None:
+        return local
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", CacheWarning)
+        loaded = DetectionCache(prepared.cache_root).load(prepared.key)
+    if loaded is None:
+        why = "; ".join(str(w.message) for w in caught) or "it is gone"
+        raise CacheError(
+            DetectionCache(prepared.cache_root).path(prepared.key),
+            f"the detection cache entry written moments ago cannot be read back ({why})",
+        )
+    _keep_local(prepared.key, loaded)
+    return loaded
 
 
 def _brief(prepared: _Prepared | _Failed) -> _Brief:
@@ -371,22 +440,23 @@ def _brief(prepared: _Prepared | _Failed) -> _Brief:
 _Tracked = tuple[tuple[tuple[TrackOutput, ...], ...], float]
 
 
-def _track(prepared: _Prepared | _Failed, config: RunConfig) -> _Tracked | _Failed:
+def _track(prepared: _Prepared | _Stored | _Failed, config: RunConfig) -> _Tracked | _Failed:
     """Track one grid point on one sequence (scored by :func:`_score`, a task of its own)."""
     if isinstance(prepared, _Failed):
         return prepared
     start = time.perf_counter()
     try:
+        detections = _detections_of(prepared)
         # A tracker that reads frames replays them from the recording, read again.
         recording = open_for(prepared.path, config) if needs_frame(config) else None
-        tracks = track_sequence(prepared.detections, config, recording)
+        tracks = track_sequence(detections, config, recording)
     except RgbdEvalError as err:
         return _failed(err)
     return tracks, time.perf_counter() - start
 
 
 def _score(
-    prepared: _Prepared | _Failed, tracked: _Tracked | _Failed, config: RunConfig
+    prepared: _Prepared | _Stored | _Failed, tracked: _Tracked | _Failed, config: RunConfig
 ) -> tuple[Counts, float] | _Failed:
     """Score one grid point's tracks; the seconds are the track and score tasks' together."""
     if isinstance(prepared, _Failed):
@@ -402,10 +472,10 @@ def _score(
     return scores.counts, track_seconds + time.perf_counter() - start
 
 
-def _worker_threads(client: Client) -> int:
-    """Task slots of the cluster (threads summed over its workers), at least 1."""
+def _worker_slots(client: Client) -> list[str]:
+    """The cluster's task slots: each worker's address once per thread, in address order."""
     workers = client.scheduler_info().get("workers", {})
-    return max(1, sum(int(w.get("nthreads", 1)) for w in workers.values()))
+    return [a for a, w in sorted(workers.items()) for _ in range(int(w.get("nthreads", 1)))]
 
 
 def _submit_chunks(
@@ -415,30 +485,37 @@ def _submit_chunks(
     config: RunConfig,
     plan: ChunkPlan,
     cache_root: Path | None,
+    slots: Sequence[str | None],
 ) -> Future[Any]:
     """The chunk tasks of one recording's detection; returns the future of their join.
 
     The advance chain (each link the state after one more chunk) is submitted first,
-    so it runs ahead of the chunk detections that wait on it.
+    so it runs ahead of the chunk detections that wait on it. ``slots``: the group's
+    workers, one per chunk; the first also ran the prepare task (see :func:`run_sweep`).
     """
     states: list[Any] = [None]
     for k in range(plan.chunks - 1):
-        states.append(_submit(client, _advance, opened, config, plan, k, states[-1], index=k))
-    # Chunk 0 needs no state: it is ready as soon as the recording is open. Dask places a
-    # task only on a worker that holds one of its inputs, so chunk 0 would queue behind the
-    # advance pass on the prepare task's worker until work stealing moved it (1.3-4 s at a
-    # load of 12-22). Its config, scattered to every worker, makes each one a candidate.
-    anywhere = client.scatter(config, broadcast=True, hash=False)
+        states.append(
+            _submit(client, _advance, opened, config, plan, k, states[-1], index=k, on=slots[0])
+        )
+    # Where each chunk runs is stated, loosely (a lost worker's tasks still run elsewhere):
+    # the advance chain stays on the prepare task's worker, which then detects the last
+    # (shortest) chunk; chunk k < K-1 goes to slot k+1, so chunk 0 starts as soon as the
+    # recording is open. Left to itself, Dask places a task on a worker that holds one of
+    # its inputs: chunk 0 then queued behind the advance pass on the prepare task's worker
+    # in 3 of 11 idle runs of bench/dask_scaling.py, starting 0.6-1.0 s late, or the chunk
+    # after the advance pass went to the other worker and waited for its state.
     parts = [
         _submit(
             client,
             _detect_chunk,
             opened,
-            anywhere if k == 0 else config,
+            config,
             plan,
             k,
             states[k],
             index=k,
+            on=slots[(k + 1) % plan.chunks],
         )
         for k in range(plan.chunks)
     ]
@@ -446,18 +523,27 @@ def _submit_chunks(
 
 
 def _submit(
-    client: Client, func: Callable[..., Any], *args: Any, index: int | None = None
+    client: Client,
+    func: Callable[..., Any],
+    *args: Any,
+    index: int | None = None,
+    on: str | None = None,
 ) -> Future[Any]:
     """``client.submit(func, *args)``, run in submission order among ready tasks.
 
     Dask gives every task submitted within ``fifo_timeout`` (100 ms by default) of the
     previous one the same priority, so a burst of submissions runs in no set order; 0
     starts a new priority generation with each call. The key names ``func`` and ``index``
-    (chunk, or unit of the sweep), which the task stream then shows.
+    (chunk, or unit of the sweep), which the task stream then shows. ``on``: the worker
+    the task should run on, if it is alive and free (a loose restriction).
     """
     tag = f"-{index}" if index is not None else ""
     key = f"{func.__name__}{tag}-{uuid.uuid4().hex}"
-    return client.submit(func, *args, key=key, fifo_timeout=0)
+    if on is None:
+        return client.submit(func, *args, key=key, fifo_timeout=0)
+    return client.submit(
+        func, *args, key=key, fifo_timeout=0, workers=[on], allow_other_workers=True
+    )
 
 
 def _outcome(future: Future[Any]) -> Any:
@@ -513,12 +599,13 @@ def run_sweep(
     groups: dict[tuple[Path, str], list[int]] = {}
     for i, (_, cfg, path) in enumerate(units):
         groups.setdefault((path, detector_inputs(cfg)), []).append(i)
-    slots_per_group = max(1, _worker_threads(client) // max(1, len(groups)))
+    slots = _worker_slots(client)
+    slots_per_group = max(1, len(slots) // max(1, len(groups)))
     prepared: dict[tuple[Path, str], Future[Any]] = {}
     briefs: dict[tuple[Path, str], Future[Any]] = {}
     tracked: dict[int, Future[Any]] = {}  # the score task of each unit
     rejected: list[str] = []
-    for group, members in groups.items():
+    for g, (group, members) in enumerate(groups.items()):
         path, cfg = group[0], units[members[0]][1]
         cached = None
         if client_side:
@@ -539,6 +626,11 @@ def run_sweep(
             plan = replace(plan, advance_cost=advance_cost(cfg))
         gt = gt_path.resolve() if gt_path is not None else None
         cache_at = None if client_side else root
+        # A split group's tasks are placed on its own slots (wrapping round when there are
+        # more groups than slots can split, which only happens with an explicit plan).
+        mine: list[str | None] = [
+            slots[(g * plan.chunks + k) % len(slots)] if slots else None for k in range(plan.chunks)
+        ]
         prep = _submit(
             client,
             _prepare,
@@ -549,17 +641,20 @@ def run_sweep(
             cache_at,
             client.scatter(cached) if cached is not None else None,
             split,
+            on=mine[0] if split else None,
         )
         if split:
-            prep = _submit_chunks(client, path.resolve(), prep, cfg, plan, cache_at)
+            prep = _submit_chunks(client, path.resolve(), prep, cfg, plan, cache_at, mine)
         briefs[group] = _submit(client, _brief, prep)
         # Tracking and scoring are separate tasks (about 0.35 and 0.15 s on moving_complex):
         # 2 x 9 tasks of uneven size fill two workers more evenly than 9 equal ones. All the
         # track tasks first, so every worker tracks before it scores. The client keeps no
         # reference to a track task: its tracks are freed once scored.
-        tracks = [_submit(client, _track, prep, units[i][1], index=i) for i in members]
+        # With a shared cache, track and score tasks take the detections from it.
+        use = prep if cache_at is None else _submit(client, _stored, prep, cache_at)
+        tracks = [_submit(client, _track, use, units[i][1], index=i) for i in members]
         for i, track in zip(members, tracks, strict=True):
-            tracked[i] = _submit(client, _score, prep, track, units[i][1], index=i)
+            tracked[i] = _submit(client, _score, use, track, units[i][1], index=i)
         if client_side:
             # Kept to fetch fresh detections. Otherwise the client holds no reference, so
             # the scheduler frees the detections once this group's track tasks are done.
