@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+import threading
 import time
 import uuid
 import warnings
@@ -236,13 +237,16 @@ class _Stored:
 #: track tasks of one recording read its cache entry once per worker (see :func:`_stored`).
 _LOCAL_DETECTIONS: dict[str, SequenceDetections] = {}
 _LOCAL_KEEP = 2
+#: A worker may run tasks in several threads (``dask worker --nthreads N``).
+_LOCAL_LOCK = threading.Lock()
 
 
 def _keep_local(key: str, detections: SequenceDetections) -> None:
-    _LOCAL_DETECTIONS.pop(key, None)
-    _LOCAL_DETECTIONS[key] = detections
-    while len(_LOCAL_DETECTIONS) > _LOCAL_KEEP:
-        del _LOCAL_DETECTIONS[next(iter(_LOCAL_DETECTIONS))]
+    with _LOCAL_LOCK:
+        _LOCAL_DETECTIONS.pop(key, None)
+        _LOCAL_DETECTIONS[key] = detections
+        while len(_LOCAL_DETECTIONS) > _LOCAL_KEEP:
+            del _LOCAL_DETECTIONS[next(iter(_LOCAL_DETECTIONS))]
 
 
 @dataclass(frozen=True)
@@ -414,7 +418,8 @@ def _detections_of(prepared: _Prepared | _Stored) -> SequenceDetections:
     """The detections of a prepare result, loaded from the shared cache when not at hand."""
     if isinstance(prepared, _Prepared):
         return prepared.detections
-    local = _LOCAL_DETECTIONS.get(prepared.key)
+    with _LOCAL_LOCK:
+        local = _LOCAL_DETECTIONS.get(prepared.key)
     if local is not None:
         return local
     with warnings.catch_warnings(record=True) as caught:
