@@ -237,7 +237,7 @@ class _Stored:
 #: track tasks of one recording read its cache entry once per worker (see :func:`_stored`).
 _LOCAL_DETECTIONS: dict[str, SequenceDetections] = {}
 _LOCAL_KEEP = 2
-#: A worker may run tasks in several threads (``dask worker --nthreads N``).
+#: A worker may run tasks in several threads (a remote worker started with several).
 _LOCAL_LOCK = threading.Lock()
 
 
