@@ -303,6 +303,10 @@ class DetectionCache:
         """Where the entry of ``key`` lives."""
         return self.root / "detections" / key[:2] / f"{key}.det"
 
+    def has(self, key: str) -> bool:
+        """Whether an entry of ``key`` is present (not checked: :meth:`load` verifies)."""
+        return self.path(key).is_file()
+
     def load(self, key: str) -> SequenceDetections | None:
         """The entry of ``key``; None when absent or rejected (a rejection warns)."""
         path = self.path(key)

@@ -409,7 +409,7 @@ def _stored(prepared: _Prepared | _Failed, cache_root: Path) -> _Prepared | _Sto
     """
     if not isinstance(prepared, _Prepared):
         return prepared
-    if not DetectionCache(cache_root).path(prepared.key).is_file():
+    if not DetectionCache(cache_root).has(prepared.key):
         return prepared  # not stored (it could not be written): the detections travel
     return _Stored(prepared.path, prepared.key, cache_root, prepared.ground_truth)
 
@@ -422,13 +422,14 @@ def _detections_of(prepared: _Prepared | _Stored) -> SequenceDetections:
         local = _LOCAL_DETECTIONS.get(prepared.key)
     if local is not None:
         return local
+    cache = DetectionCache(prepared.cache_root)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", CacheWarning)
-        loaded = DetectionCache(prepared.cache_root).load(prepared.key)
+        loaded = cache.load(prepared.key)
     if loaded is None:
         why = "; ".join(str(w.message) for w in caught) or "it is gone"
         raise CacheError(
-            DetectionCache(prepared.cache_root).path(prepared.key),
+            cache.path(prepared.key),
             f"the detection cache entry written moments ago cannot be read back ({why})",
         )
     _keep_local(prepared.key, loaded)
@@ -625,7 +626,7 @@ def run_sweep(
             # recording and pass. Looked up by the memoised digest alone (no hashing); an
             # entry that then fails its checksum is detected in one pass by the prepare task.
             known = cache.known_digest(path)
-            split = known is None or not cache.path(detection_key(known, cfg)).is_file()
+            split = known is None or not cache.has(detection_key(known, cfg))
         if split and chunks is None:
             # Chunks shorter where they wait longer for the detector's state.
             plan = replace(plan, advance_cost=advance_cost(cfg))
