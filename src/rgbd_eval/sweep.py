@@ -325,7 +325,8 @@ def _prepare(
         matched = match_ground_truth(gt, detections.stamps_ns, config)
     except RgbdEvalError as err:
         return _failed(err)
-    _keep_local(key, detections)
+    if cache_root is not None:  # only track tasks handed a _Stored record read the memo
+        _keep_local(key, detections)
     return _Prepared(path, key, detections, matched, time.perf_counter() - start, hit, rejected)
 
 
@@ -395,7 +396,8 @@ def _join(
     except RgbdEvalError as err:
         return _failed(err)
     seconds = opened.seconds + sum(t for _, t in chunks) + time.perf_counter() - start
-    _keep_local(key, detections)
+    if cache_root is not None:
+        _keep_local(key, detections)
     return _Prepared(path, key, detections, matched, seconds, False, opened.rejected)
 
 
