@@ -9,7 +9,16 @@ from typing import Any
 from rgbd_eval.chunked import ChunkPlan
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.engine import worker_environ
-from rgbd_eval.sweep import _advance, _detect_chunk, _join, _submit, _submit_chunks
+from rgbd_eval.sweep import (
+    _advance,
+    _detect_chunk,
+    _join,
+    _score,
+    _submit,
+    _submit_chunks,
+    _submit_points,
+    _track,
+)
 
 
 @dataclass(frozen=True)
@@ -104,3 +113,28 @@ def test_worker_environment_keeps_thread_limits_not_the_trim_threshold() -> None
     dask_default = {"MALLOC_TRIM_THRESHOLD_": 65536, "OMP_NUM_THREADS": 1}
     assert worker_environ(dask_default) == {"OMP_NUM_THREADS": 1}
     assert worker_environ({}) == {}
+
+
+def test_track_and_score_tasks_alternate_over_the_group_slots() -> None:
+    client = RecordingClient()
+    prepared = Submitted(print, (), "_stored-x")
+    cfg = config()
+    points = [(10 + j, cfg) for j in range(5)]
+    scores: Any = _submit_points(client, prepared, points, ["tcp://a:1", "tcp://b:1"])  # type: ignore[arg-type]
+    futures = [f for f, _ in client.calls]
+    # All 5 track tasks first, then the 5 score tasks, each scoring its own track.
+    assert [f.func for f in futures] == [_track] * 5 + [_score] * 5
+    tracks = futures[:5]
+    assert [f.key.rsplit("-", 1)[0] for f in tracks] == [f"_track-{i}" for i in range(10, 15)]
+    assert list(scores) == list(range(10, 15))
+    assert [scores[i].args[:2] for i in range(10, 15)] == [(prepared, t) for t in tracks]
+    placed = "".join(o["workers"][0][len("tcp://")] for _, o in client.calls)
+    # Tracks a b a b a (3 on a), scores one slot on: b a b a b (3 on b): 5 tasks each.
+    assert placed == "ababa" + "babab"
+    assert all(o["allow_other_workers"] for _, o in client.calls)
+
+
+def test_track_and_score_tasks_without_slots_are_not_placed() -> None:
+    client = RecordingClient()
+    _submit_points(client, Submitted(print, (), "p"), [(0, config()), (1, config())], [])  # type: ignore[arg-type]
+    assert all(options == {"fifo_timeout": 0} for _, options in client.calls)

@@ -530,6 +530,44 @@ def _submit_chunks(
     return _submit(client, _join, path, opened, config, cache_root, *parts)
 
 
+def _submit_points(
+    client: Client,
+    prepared: Future[Any],
+    points: Sequence[tuple[int, RunConfig]],
+    slots: Sequence[str | None],
+) -> dict[int, Future[Any]]:
+    """The track and score tasks of one group's ``points`` (unit index, config): the score
+    task's future of each unit.
+
+    Tracking and scoring are separate tasks (about 0.35 and 0.17 s on moving_complex):
+    2 x 9 tasks of uneven size fill two workers more evenly than 9 equal ones. The track
+    tasks are submitted first, so a worker tracks before it scores, and the client keeps
+    no reference to them: their tracks are freed once scored.
+
+    ``slots``: the group's own workers (several when there are fewer groups than
+    workers), over which the tasks are placed, loosely: track ``j`` on slot ``j``,
+    its score on slot ``j + 1`` (mod the count), so that with two slots and an odd count
+    the worker with one track more has one score fewer. Left to itself, Dask queues the track tasks at the scheduler
+    (root-ish: many tasks on one small input) and sends each finished track's score to a
+    worker holding one of its inputs, always including the worker that holds the
+    prepare result: on moving_complex one worker ended on a track and its score (0.5 s)
+    while the other idled. With no ``slots``, the tasks go where Dask puts them (many
+    groups keep every worker busy, and the queue keeps few detections loaded).
+    """
+
+    def on(j: int) -> str | None:
+        return slots[j % len(slots)] if slots else None
+
+    tracks = [
+        _submit(client, _track, prepared, config, index=i, on=on(j))
+        for j, (i, config) in enumerate(points)
+    ]
+    return {
+        i: _submit(client, _score, prepared, track, config, index=i, on=on(j + 1))
+        for j, ((i, config), track) in enumerate(zip(points, tracks, strict=True))
+    }
+
+
 def _submit(
     client: Client,
     func: Callable[..., Any],
@@ -654,15 +692,10 @@ def run_sweep(
         if split:
             prep = _submit_chunks(client, path.resolve(), prep, cfg, plan, cache_at, mine)
         briefs[group] = _submit(client, _brief, prep)
-        # Tracking and scoring are separate tasks (about 0.35 and 0.15 s on moving_complex):
-        # 2 x 9 tasks of uneven size fill two workers more evenly than 9 equal ones. All the
-        # track tasks first, so every worker tracks before it scores. The client keeps no
-        # reference to a track task: its tracks are freed once scored.
         # With a shared cache, track and score tasks take the detections from it.
         use = prep if cache_at is None else _submit(client, _stored, prep, cache_at)
-        tracks = [_submit(client, _track, use, units[i][1], index=i) for i in members]
-        for i, track in zip(members, tracks, strict=True):
-            tracked[i] = _submit(client, _score, use, track, units[i][1], index=i)
+        points = [(i, units[i][1]) for i in members]
+        tracked |= _submit_points(client, use, points, mine if len(mine) > 1 else [])
         if client_side:
             # Kept to fetch fresh detections. Otherwise the client holds no reference, so
             # the scheduler frees the detections once this group's track tasks are done.
