@@ -107,9 +107,11 @@ class Basso2012Detector:
 
     #: :meth:`advance`'s CPU time per frame as a fraction of :meth:`detect`'s, which balances
     #: chunk lengths (:class:`rgbd_eval.chunked.ChunkPlan`; results never depend on it).
-    #: Measured in one process over the first half of a recording: 0.76 / 2.75 s on
-    #: moving_complex (375 frames), 0.43 / 1.53 s on static_clutter (120 frames).
-    advance_cost = 0.28
+    #: The median over the 8 thesis scenarios (first half of each, second pass in one
+    #: process: 0.116 static_clutter ... 0.196 moving_simple, 0.189 moving_complex). A
+    #: first pass costs both about 0.2 s more, once per process, and each chunk's worker pays
+    #: it, so it is left out (it gave 0.28, and chunk 0 ended 0.15-0.4 s after chunk 1).
+    advance_cost = 0.18
 
     def __init__(self, config: Basso2012DetectorConfig) -> None:
         if not isinstance(config, Basso2012DetectorConfig):
