@@ -5,8 +5,10 @@ Runs the sweep on ``local:1`` and ``local:2``, cold cache (a fresh folder) and w
 (cold 1, cold 2, warm 1, warm 2, then again), on two clusters started once and kept
 (as a lab keeps a running scheduler and its workers; the start-up is reported
 apart). Prints, per run, the sweep's wall clock, the CPU seconds of the client and
-of every worker process, the load average before and after, and from the Dask task
-stream each worker's busy seconds and the makespan; then the medians and ratios.
+of every worker process, the load average before and after, the CPU time the
+hypervisor stole (``/proc/stat``), and from the Dask task stream each worker's busy
+seconds and the makespan; then the medians and ratios, and the ratio of each
+repetition's pair (run back to back, so sharing the moment's load).
 
 The wall-clock ratio is what an idle machine shows. On a shared one it is noise,
 so the script also gives an estimate that the load moves less: the thread CPU
@@ -54,6 +56,16 @@ def _cpu_here() -> float:
     """CPU seconds of this process (user + system), all threads."""
     t = os.times()
     return t.user + t.system
+
+
+def _steal_s() -> float | None:
+    """Seconds the hypervisor ran something else while this machine's CPUs wanted to run
+    (``steal`` in ``/proc/stat``, all CPUs), or None where there is no such count."""
+    try:
+        fields = Path("/proc/stat").read_text().split("\n", 1)[0].split()
+        return int(fields[8]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, IndexError, ValueError):
+        return None
 
 
 def _worker_cpu() -> float:
@@ -235,12 +247,14 @@ def _one_run(
     from distributed import get_task_stream
 
     load_before = os.getloadavg()[0]
+    steal0 = _steal_s()
     tasks0 = _task_cpu(client)
     cpu0 = _process_cpu(client, workers == 1)
     start = time.perf_counter()
     with get_task_stream(client) as stream:
         result = run_sweep([recording], grid, configs, client, cache_root=cache)
     wall = time.perf_counter() - start
+    steal1 = _steal_s()
     cpu = _process_cpu(client, workers == 1) - cpu0
     tasks1 = _task_cpu(client)
     task_cpu = {k: round(v - tasks0.get(k, 0.0), 3) for k, v in tasks1.items()}
@@ -258,6 +272,7 @@ def _one_run(
         "cpu_s": round(cpu, 3),
         "load_before": round(load_before, 2),
         "load_after": round(os.getloadavg()[0], 2),
+        "steal_s": None if steal0 is None or steal1 is None else round(steal1 - steal0, 2),
         "detect_task_s": round(result.detect_seconds, 3),
         "track_task_s": round(result.track_seconds, 3),
         "cache_hits": result.cache_hits,
@@ -326,7 +341,7 @@ def main() -> int:
                         print(
                             f"rep {rep + 1} {mode} local:{n}: wall {run['wall_s']:6.2f} s  "
                             f"cpu {run['cpu_s']:6.2f} s  load {run['load_before']:5.2f}"
-                            f"->{run['load_after']:5.2f}  busy {run['busy_s']} of makespan "
+                            f"->{run['load_after']:5.2f}  steal {run['steal_s']} s  busy {run['busy_s']} of makespan "
                             f"{run['makespan_s']:.2f} s (utilisation {run['utilisation']:.2f}), "
                             f"{run['tasks']} tasks, cache hits {run['cache_hits']}; "
                             f"task CPU {run['task_cpu_s']}; idle estimate on 1 / 2 slots "
@@ -344,12 +359,18 @@ def main() -> int:
         # Idle machine: local:1's graph on one slot over local:2's graph on two, every task
         # taking the thread CPU seconds it took in its run.
         estimate = one["estimate_1_s"] / two["estimate_2_s"]
+        # Each repetition's pair ran back to back, so its ratio shares most of the moment's load.
+        per_rep = [
+            round(a["wall_s"] / b["wall_s"], 3)
+            for a, b in zip(runs[(mode, 1)], runs[(mode, 2)], strict=True)
+        ]
         summary[mode] = {
             "local1": one,
             "local2": two,
             "wall_ratio": round(wall_ratio, 3),
             "wall_ratio_with_startup": round(with_startup, 3),
             "estimate_ratio": round(estimate, 3),
+            "wall_ratio_per_rep": per_rep,
         }
         print(
             f"{mode}: wall {one['wall_s']:.2f} / {two['wall_s']:.2f} s = {wall_ratio:.2f}x "
@@ -357,6 +378,10 @@ def main() -> int:
             f"{two['load_before']:.1f}; process CPU {one['cpu_s']:.2f} / {two['cpu_s']:.2f} s; "
             f"task-stream utilisation of local:2 {two['utilisation']:.2f}; critical path from "
             f"task CPU: {one['estimate_1_s']:.2f} / {two['estimate_2_s']:.2f} s = {estimate:.2f}x"
+        )
+        print(
+            f"{mode}: per repetition {', '.join(f'{r:.2f}' for r in per_rep)}x "
+            f"(median {statistics.median(per_rep):.2f}x)"
         )
     if args.json is not None:
         args.json.parent.mkdir(parents=True, exist_ok=True)
