@@ -341,7 +341,8 @@ def main() -> int:
                         print(
                             f"rep {rep + 1} {mode} local:{n}: wall {run['wall_s']:6.2f} s  "
                             f"cpu {run['cpu_s']:6.2f} s  load {run['load_before']:5.2f}"
-                            f"->{run['load_after']:5.2f}  steal {run['steal_s']} s  busy {run['busy_s']} of makespan "
+                            f"->{run['load_after']:5.2f}  steal {run['steal_s']} s  "
+                            f"busy {run['busy_s']} of makespan "
                             f"{run['makespan_s']:.2f} s (utilisation {run['utilisation']:.2f}), "
                             f"{run['tasks']} tasks, cache hits {run['cache_hits']}; "
                             f"task CPU {run['task_cpu_s']}; idle estimate on 1 / 2 slots "

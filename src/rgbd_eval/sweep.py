@@ -551,7 +551,7 @@ def _submit_points(
     moving_complex one worker ended on a track and its score (0.5 s) while the other idled.
     A score task goes where Dask puts it, on a worker holding its track or the prepare
     result: placed on the other slot as well, its tracks (230 KB) had to be copied, 0.1-0.2
-    s each while the sender computed, and the sweep was slower (7 repetitions: cold 1.60x
+    s each while the sender computed, and the sweep was slower (9 repetitions: cold 1.60x
     against 1.69x, warm 1.73x against 1.84x). With no ``slots``, every task goes where Dask
     puts it (many groups keep every worker busy, and the queue keeps few detections loaded).
     """
