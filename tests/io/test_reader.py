@@ -4,10 +4,12 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
+from rgbd_eval.io import reader
 from rgbd_eval.io.images import depth_to_mm
 from rgbd_eval.io.reader import open_recording
 from rgbd_eval.io.writer import StreamOptions
@@ -144,3 +146,50 @@ def test_ros2_folder_keeps_no_temporary_names(
     assert sorted(p.name for p in path.iterdir()) == sorted(["metadata.yaml", path.name + suffix])
     assert ".tmp-" not in (path / "metadata.yaml").read_text()
     assert len(open_recording(path)) == 5
+
+
+@pytest.mark.parametrize("container", CONTAINERS)
+def test_a_late_frame_range_reads_from_its_first_message_on(
+    make_recording: Callable[..., Path], container: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rec = open_recording(make_recording(container, Spec(n=12)))
+    whole = list(rec.frames())
+    read: list[str] = []  # the topics of the messages the frame pass is handed
+    opened = reader.open_source
+
+    def counting(path: Path) -> Any:
+        src = opened(path)
+        messages = src.messages
+
+        def counted(topics: set[str], start_ns: int | None = None) -> Any:
+            for item in messages(topics, start_ns):
+                read.append(item[0])
+                yield item
+
+        src.messages = counted  # type: ignore[method-assign]
+        return src
+
+    monkeypatch.setattr(reader, "open_source", counting)
+    late = list(rec.frames(8, 12))
+    assert [f.index for f in late] == [8, 9, 10, 11]
+    for a, b in zip(whole[8:], late, strict=True):
+        assert a.stamp_ns == b.stamp_ns and a.camera_pose == b.camera_pose
+        assert np.array_equal(a.depth, b.depth, equal_nan=True)
+        assert np.array_equal(a.rgb, b.rgb)
+    # 4 frames of 2 images each: the 16 messages of frames 0-7 were not read.
+    assert len(read) == 8
+
+
+def test_a_frame_range_reads_from_the_start_when_log_times_are_out_of_order(
+    make_recording: Callable[..., Path],
+) -> None:
+    rec = open_recording(make_recording("mcap", Spec(n=6)))
+    whole = list(rec.frames())
+    depth_topic = rec.info.selected.streams["depth"]
+    times = rec._log_ns[depth_topic].copy()
+    times[[0, 1]] = times[[1, 0]]  # as a reader handing messages in file order might
+    rec._log_ns[depth_topic] = times
+    late = list(rec.frames(3, 6))
+    assert [f.index for f in late] == [3, 4, 5]
+    for a, b in zip(whole[3:], late, strict=True):
+        assert np.array_equal(a.depth, b.depth, equal_nan=True)

@@ -218,6 +218,8 @@ class _Index:
     #: Per raw image topic: (width, height) of each message kept.
     sizes: dict[str, list[tuple[int, int]]] = field(default_factory=dict)
     totals: dict[str, int] = field(default_factory=dict)
+    #: Per image topic: the log time of every message, damaged ones included, in order.
+    image_log_ns: dict[str, list[int]] = field(default_factory=dict)
     skips: integrity.SkipLog = field(default_factory=integrity.SkipLog)
     log_stamps: dict[str, list[int]] = field(default_factory=dict)
     first_msgs: dict[str, Any] = field(default_factory=dict)
@@ -252,6 +254,7 @@ class Recording:
         plan: list[_FramePlan],
         depth_to_rgb: Pose,
         ground_truth: groundtruth.GroundTruth | None,
+        log_ns: Mapping[str, NDArray[np.int64]] | None = None,
     ) -> None:
         self.path = path
         self.io = io
@@ -259,6 +262,8 @@ class Recording:
         self._plan = plan
         self._depth_to_rgb = depth_to_rgb
         self.ground_truth_topic = ground_truth
+        # Per stream topic, every message's log time in reading order (see frames()).
+        self._log_ns = dict(log_ns or {})
         self.empty_depth_frames: list[int] = []  # indices, filled while frames() runs
 
     @property
@@ -295,7 +300,9 @@ class Recording:
         span = range(start, stop)
         wanted = {role: {self._plan[k].messages[role]: k for k in span} for role in sel}
         ready: dict[int, dict[str, Any]] = {}
-        counters = dict.fromkeys(sel.values(), 0)
+        start_ns, counters = self._resume_at(
+            {topic: min(wanted[role]) for role, topic in sel.items()}
+        )
         primary = "depth" if "depth" in sel else next(iter(sel))
         next_k = start
         self.empty_depth_frames = []
@@ -303,7 +310,7 @@ class Recording:
         try:
             with open_source(self.path) as src:
                 msgtypes = {t: src.topics[t].msgtype for t in sel.values()}
-                for topic, _, raw in src.messages(set(sel.values())):
+                for topic, _, raw in src.messages(set(sel.values()), start_ns):
                     n = counters[topic]
                     counters[topic] = n + 1
                     role = by_topic[topic]
@@ -351,6 +358,29 @@ class Recording:
             )
         if next_k and len(self.empty_depth_frames) == len(self._plan):
             raise self.no_depth_error()
+
+    def _resume_at(self, first: Mapping[str, int]) -> tuple[int | None, dict[str, int]]:
+        """Where to start reading for messages ``first[topic]`` on (positions among the
+        topic's messages): a log time, and each topic's position of its first message from
+        that time on.
+
+        The earliest log time of those messages, so that a chunk late in a recording does
+        not read (decompress) every message before it. From the start (None, all 0) when
+        they are the first messages, or a topic's log times are unknown or out of order.
+        """
+        from_start: tuple[int | None, dict[str, int]] = (None, dict.fromkeys(first, 0))
+        times: dict[str, NDArray[np.int64]] = {}
+        for topic, k in first.items():
+            t = self._log_ns.get(topic)
+            if t is None or len(t) <= k or bool(np.any(np.diff(t) < 0)):
+                return from_start
+            times[topic] = t
+        if not any(first.values()):
+            return from_start
+        start = min(int(times[topic][k]) for topic, k in first.items())
+        return start, {
+            topic: int(np.searchsorted(t, start, side="left")) for topic, t in times.items()
+        }
 
     def no_depth_error(self) -> DecodeError:
         """The error of a recording none of whose depth frames holds a valid pixel."""
@@ -795,7 +825,11 @@ def open_recording(
         warnings=tuple(warnings),
         skipped=skipped,
     )
-    return Recording(path, io, info, plan, depth_to_rgb, gt)
+    log_ns = {
+        topic: np.asarray(index.image_log_ns.get(topic, []), dtype=np.int64)
+        for topic in selected.streams.values()
+    }
+    return Recording(path, io, info, plan, depth_to_rgb, gt, log_ns)
 
 
 def _skip_wrong_sizes(
@@ -852,6 +886,8 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfi
         msgtype = src.topics[topic].msgtype
         ordinal = index.totals.get(topic, 0)
         index.totals[topic] = ordinal + 1
+        if topic in images_:
+            index.image_log_ns.setdefault(topic, []).append(log_ns)
         try:  # against its definition: the bytes must deserialise, exactly consumed
             msg: Any = src.deserialize(raw, msgtype)
         except MESSAGE_ERRORS as err:

@@ -71,8 +71,11 @@ class MessageSource(AbstractContextManager["MessageSource"]):
     start_ns: int = 0
     end_ns: int = 0
 
-    def messages(self, topics: set[str]) -> Iterator[tuple[str, int, bytes | memoryview]]:
-        """``(topic, log_time_ns, raw)`` for the given topics."""
+    def messages(
+        self, topics: set[str], start_ns: int | None = None
+    ) -> Iterator[tuple[str, int, bytes | memoryview]]:
+        """``(topic, log_time_ns, raw)`` for the given topics (from log time ``start_ns`` on:
+        the container's index skips what comes before, undecompressed)."""
         raise NotImplementedError
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
@@ -107,12 +110,14 @@ class AnyReaderSource(MessageSource):
         if self._conns:
             self.start_ns, self.end_ns = self._reader.start_time, self._reader.end_time
 
-    def messages(self, topics: set[str]) -> Iterator[tuple[str, int, bytes | memoryview]]:
+    def messages(
+        self, topics: set[str], start_ns: int | None = None
+    ) -> Iterator[tuple[str, int, bytes | memoryview]]:
         conns = [c for t, c in self._conns.items() if t in topics]
         if not conns:
             return
         try:
-            for conn, log_ns, raw in self._reader.messages(connections=conns):
+            for conn, log_ns, raw in self._reader.messages(connections=conns, start=start_ns):
                 yield conn.topic, log_ns, raw
         except (AssertionError, KeyError) as err:
             # rosbags' ROS1 reader asserts that a message record's time equals its index
@@ -172,11 +177,13 @@ class McapSource(MessageSource):
             self.start_ns = min(c.message_start_time for c in summary.chunk_indexes)
             self.end_ns = max(c.message_end_time for c in summary.chunk_indexes)
 
-    def messages(self, topics: set[str]) -> Iterator[tuple[str, int, bytes | memoryview]]:
+    def messages(
+        self, topics: set[str], start_ns: int | None = None
+    ) -> Iterator[tuple[str, int, bytes | memoryview]]:
         wanted = [t for t in topics if t in self.topics]
         if not wanted:
             return
-        for _, channel, message in self._reader.iter_messages(topics=wanted):
+        for _, channel, message in self._reader.iter_messages(topics=wanted, starting_at=start_ns):
             yield channel.topic, message.log_time, message.data
 
     def deserialize(self, raw: bytes | memoryview, msgtype: str) -> Any:
