@@ -13,7 +13,9 @@ rest of the chain. The joined chunks equal the sequential run bit for bit
 (tests/test_chunked.py). Detectors that are not resumable run in one piece.
 
 Cost: the chain re-reads and re-runs the ground stages of every chunk but the
-last: with K chunks, ``(K-1)/K`` of those stages again.
+last: with K chunks, ``(K-1)/K`` of those stages again. Each task reads its own
+frames only (:meth:`~rgbd_eval.io.reader.Recording.frames` starts at the first
+one's log time), so no chunk or link re-reads the frames before it.
 """
 
 from __future__ import annotations
@@ -29,7 +31,7 @@ from rgbd_eval.io.reader import Recording
 from rgbd_eval.pipeline import SequenceDetections, detect_sequence
 
 #: Fewest frames worth a chunk of their own when the chunk count is chosen automatically:
-#: each chunk task re-creates its detector and skips the messages before its first frame.
+#: each chunk task re-creates its detector and opens the recording's reader at its first frame.
 MIN_CHUNK_FRAMES = 60
 
 
