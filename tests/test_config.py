@@ -90,3 +90,45 @@ def test_yaml_errors(tmp_path: Path) -> None:
         load_config(lst)
     with pytest.raises(ConfigError, match="cannot read config"):
         load_config(tmp_path / "missing.yaml")
+
+
+def test_a_changed_gating_takes_its_own_threshold(tmp_path: Path) -> None:
+    """Issue 28: pinto2022's metric 1.0 m must not become an IoU threshold of 1.0."""
+    iou = load_config(None, ["evaluation.gating=iou"], method="pinto2022").evaluation
+    assert iou.gating is Gating.IOU and iou.effective_threshold() == 0.5
+    # Switching to metric takes the method's metric threshold (dmtbs: 0.5 m), else 1.0 m.
+    basso = load_config(None, ["evaluation.gating=metric"], method="basso2012").evaluation
+    assert basso.effective_threshold() == 1.0
+    back = load_config(None, ["evaluation.gating=iou", "evaluation.gating=metric"], method="dmtbs")
+    assert back.evaluation.effective_threshold() == 0.5
+    # The same gating as the defaults keeps their threshold; an explicit threshold wins.
+    same = load_config(None, ["evaluation.gating=metric"], method="dmtbs").evaluation
+    assert same.effective_threshold() == 0.5
+    explicit = ["evaluation.threshold=0.3", "evaluation.gating=iou"]
+    assert load_config(None, explicit, method="pinto2022").evaluation.threshold == 0.3
+    # A config file's own gating and threshold are kept unless the gating is overridden.
+    path = tmp_path / "c.yaml"
+    path.write_text("method: pinto2022\nevaluation:\n  gating: metric\n  threshold: 0.7\n")
+    assert load_config(path).evaluation.threshold == 0.7
+    assert load_config(path, ["evaluation.gating=iou"]).evaluation.effective_threshold() == 0.5
+    # A sweep over the gating from a method's resolved config (threshold 1.0 in it).
+    from rgbd_eval.sweep import SweepParam, expand_grid, point_configs
+
+    base = load_config(method="pinto2022").model_dump(mode="json")
+    grid = expand_grid([SweepParam("evaluation.gating", ("iou", "metric"))])
+    thresholds = [c.evaluation.effective_threshold() for c in point_configs(base, [], grid)]
+    assert thresholds == [0.5, 1.0]
+
+
+@pytest.mark.parametrize(
+    ("overrides", "match"),
+    [
+        (["evaluation.threshold=1.5"], r"IoU threshold=1.5 must be in \(0, 1\]"),
+        (["evaluation.threshold=0"], "greater than 0"),
+        (["evaluation.gating=metric", "evaluation.threshold=.inf"], "finite number"),
+        (["evaluation.gating=metric", "evaluation.threshold=-1"], "greater than 0"),
+    ],
+)
+def test_a_threshold_outside_its_gating_range_is_refused(overrides: list[str], match: str) -> None:
+    with pytest.raises(ConfigError, match=match):
+        load_config(None, overrides, method="basso2012")

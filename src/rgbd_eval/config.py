@@ -12,6 +12,7 @@ dotted keys::
 from __future__ import annotations
 
 import enum
+import math
 import os
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -154,9 +155,39 @@ class EvaluationConfig(_Model):
 
     @model_validator(mode="after")
     def _check(self) -> EvaluationConfig:
-        if self.gating is Gating.IOU and self.threshold is not None and self.threshold > 1.0:
-            raise ValueError(f"IoU threshold={self.threshold} must be in (0, 1]")
+        problem = None if self.threshold is None else threshold_problem(self.gating, self.threshold)
+        if problem is not None:
+            raise ValueError(problem)
         return self
+
+
+def threshold_problem(gating: Gating, threshold: float) -> str | None:
+    """Why ``threshold`` cannot gate ``gating`` (IoU in (0, 1], metres > 0 and finite), or None."""
+    if gating is Gating.IOU:
+        return None if 0.0 < threshold <= 1.0 else f"IoU threshold={threshold} must be in (0, 1]"
+    if 0.0 < threshold < math.inf:
+        return None
+    return f"metric threshold={threshold} must be a finite distance > 0 (metres)"
+
+
+def gating_threshold(method: str, gating: Gating) -> float | None:
+    """The threshold ``gating`` takes when it is chosen without one.
+
+    The method's own threshold where its defaults use that gating (dmtbs: metric 0.5 m),
+    else None: the gating's default (IoU 0.5, 1.0 m).
+    """
+    evaluation = method_defaults(method)[0].get("evaluation")
+    threshold = evaluation.get("threshold") if isinstance(evaluation, Mapping) else None
+    if _gating_of(evaluation) != gating.value or not isinstance(threshold, int | float):
+        return None
+    return float(threshold)
+
+
+def _gating_of(evaluation: Any) -> Any:
+    """The raw gating of a raw ``evaluation`` section (the model's default where absent)."""
+    default = EvaluationConfig.model_fields["gating"].default
+    gating = evaluation.get("gating", default) if isinstance(evaluation, Mapping) else default
+    return gating.value if isinstance(gating, Gating) else gating
 
 
 class RunConfig(_Model):
@@ -366,6 +397,7 @@ def build_config(
     from rgbd_eval.plugins import method_spec
 
     merged: dict[str, Any] = _deep_copy(dict(data or {}))
+    gating_before = _gating_of(merged.get("evaluation"))
     overridden = []
     for key, value in overrides:
         set_dotted(merged, key, value)
@@ -374,6 +406,7 @@ def build_config(
     if not isinstance(method, str):
         raise ConfigError(f"{source}: method: expected a name, got {method!r}")
     method_spec(method)
+    _threshold_follows_gating(merged, gating_before, [k for k, _ in overridden], method)
     parts: list[tuple[str, str]] = []
     for section in _SECTIONS:
         try:
@@ -394,6 +427,26 @@ def build_config(
             by = f"{source} with " + " ".join(f"--set {k}={v}" for k, v in overridden)
         blamed.append(f"{by or source}: {loc or '<root>'}: {msg}")
     raise ConfigError("; ".join(blamed))
+
+
+def _threshold_follows_gating(
+    merged: dict[str, Any], before: Any, keys: list[str], method: str
+) -> None:
+    """An override that changes the gating, with none of the threshold, resets the threshold.
+
+    The threshold of the config's own gating (pinto2022's metric 1.0 m) means nothing under
+    another gating (an IoU of 1.0 matches nothing): it becomes :func:`gating_threshold`.
+    """
+    evaluation = merged.get("evaluation")
+    if "evaluation.gating" not in keys or "evaluation.threshold" in keys:
+        return
+    if not isinstance(evaluation, dict) or _gating_of(evaluation) == before:
+        return
+    try:
+        gating = Gating(_gating_of(evaluation))
+    except ValueError:  # validation names the bad gating
+        return
+    evaluation["threshold"] = gating_threshold(method, gating)
 
 
 def _deep_copy(d: Mapping[str, Any]) -> dict[str, Any]:

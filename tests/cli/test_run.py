@@ -5,11 +5,13 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
 from typer.testing import CliRunner
 
 from rgbd_eval.cli.main import app
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.types import Box2D, GroundTruthObject
+from tests.fuzz.cli import run_cli
 from tests.io.conftest import PERIOD, T0, Spec, write_recording
 
 runner = CliRunner()
@@ -116,3 +118,41 @@ def test_topic_option_chooses_streams_on_run_bench_and_sweep(tmp_path: Path) -> 
     )
     assert ok.exit_code == 0, ok.output
     assert not (tmp_path / "o").exists()
+
+
+def test_gating_option_takes_its_own_threshold(tmp_path: Path) -> None:
+    """Issue 28: pinto2022's metric 1.0 m was kept as an IoU threshold (nothing matched)."""
+    rec = write_recording(tmp_path / "r.mcap", "mcap", Spec(n=3))
+    runs = {
+        "iou": ["--gating", "iou"],
+        "iou_0.3": ["--gating", "iou", "--threshold", "0.3"],
+        "metric": ["--gating", "metric"],
+    }
+    thresholds = {}
+    for name, options in runs.items():
+        out = tmp_path / name
+        args = ["run", str(rec), "--method", "pinto2022", *options, "--out", str(out)]
+        result = runner.invoke(app, args)
+        assert result.exit_code == 0, result.output
+        report = json.loads((out / "report.json").read_text())
+        thresholds[name] = report["evaluation"]["threshold"]
+    assert thresholds == {"iou": 0.5, "iou_0.3": 0.3, "metric": 1.0}
+
+
+def test_threshold_outside_its_gating_range_is_a_usage_error(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    rec = write_recording(tmp_path / "r.mcap", "mcap", Spec(n=2, ground_truth=False))
+    for options, problem in (
+        (["--threshold", "1.5"], "IoU threshold=1.5 must be in (0, 1]"),
+        (["--gating", "metric", "--threshold", "inf"], "metric threshold=inf must be a finite"),
+        (["--method", "pinto2022", "--threshold", "-1"], "metric threshold=-1.0 must be"),
+        (["--gating", "iou", "--threshold", "nan"], "IoU threshold=nan must be in"),
+    ):
+        out = tmp_path / "o"
+        outcome = run_cli(["run", str(rec), *options, "--out", str(out)], capsys)
+        assert outcome.code == 2, outcome
+        (line,) = outcome.error_lines
+        assert line.startswith("error: Invalid value for '--threshold': "), line
+        assert problem in line and line.endswith("run --help)"), line
+        assert not out.exists()

@@ -143,3 +143,29 @@ def test_score_on_a_cluster_gives_the_same_report(tmp_path: Path) -> None:
         assert result.exit_code == 0, result.output
         reports.append(json.loads((out / "report.json").read_text())["sequences"])
     assert reports[0] == reports[1] and reports[0][0]["counts"]["num_matches"] == 2
+
+
+def test_gating_option_replaces_the_config_files_threshold(tmp_path: Path) -> None:
+    """Issue 28: a config's metric 1.0 m kept under ``--gating iou`` (nothing can match)."""
+    gt, tracks = _write(tmp_path)
+    config = tmp_path / "metric.yaml"
+    config.write_text("evaluation:\n  gating: metric\n  threshold: 1.0\n")
+    out = tmp_path / "out"
+    args = ["score", str(tracks), "--gt", str(gt), "--config", str(config), "--gating", "iou"]
+    result = runner.invoke(app, [*args, "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    report = json.loads((out / "report.json").read_text())
+    assert report["evaluation"]["threshold"] == 0.5
+    # Boxes equal to the ground truth's (IoU 1.0) match at 0.5.
+    assert report["sequences"][0]["counts"]["num_matches"] == 2
+
+
+def test_threshold_outside_its_gating_range_is_a_usage_error(tmp_path: Path) -> None:
+    gt, tracks = _write(tmp_path)
+    base = ["score", str(tracks), "--gt", str(gt), "--out", str(tmp_path / "o")]
+    for options in (["--threshold", "2"], ["--gating", "metric", "--threshold", "nan"]):
+        result = runner.invoke(app, [*base, *options])
+        assert result.exit_code == 2, result.output
+        assert "Invalid value for '--threshold'" in result.output
+    result = runner.invoke(app, [*base, "--gating", "iou", "--threshold", "1"])
+    assert result.exit_code == 0, result.output

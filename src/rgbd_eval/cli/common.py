@@ -23,6 +23,7 @@ from rich.progress import (
 from rgbd_eval.errors import ConfigError, RgbdEvalError
 
 if TYPE_CHECKING:
+    from rgbd_eval.config import RunConfig
     from rgbd_eval.sweep import CacheMode
 
 P = ParamSpec("P")
@@ -153,6 +154,23 @@ def topic_overrides(items: list[str] | None) -> list[str]:
             raise ConfigError(f"--topic {item!r}: expected ROLE=/topic, e.g. depth=/camera/depth")
         out.append(f"io.topics.{role.strip()}={topic.strip()}")
     return out
+
+
+def with_threshold(config: RunConfig, threshold: float | None) -> RunConfig:
+    """``config`` with ``--threshold`` applied: a usage error outside its gating's range.
+
+    The range depends on the gating, which the method or config file may set: the option
+    is applied after the config (``--gating`` included) is built.
+    """
+    from rgbd_eval.config import threshold_problem
+
+    if threshold is None:
+        return config
+    problem = threshold_problem(config.evaluation.gating, threshold)
+    if problem is not None:
+        raise typer.BadParameter(problem, param_hint="'--threshold'")
+    evaluation = config.evaluation.model_copy(update={"threshold": threshold})
+    return config.model_copy(update={"evaluation": evaluation})
 
 
 def jsonable(value: Any) -> Any:

@@ -21,6 +21,7 @@ from rgbd_eval.cli.common import (
     handle_errors,
     progress_bar,
     topic_overrides,
+    with_threshold,
 )
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.errors import InputError
@@ -142,9 +143,8 @@ def run(
     sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:
         sets.append(f"evaluation.gating={gating}")
-    if threshold is not None:
-        sets.append(f"evaluation.threshold={threshold}")
     config = load_config(config_file, sets, method=method or (None if config_file else "basso2012"))
+    config = with_threshold(config, threshold)
     inputs = list(paths or [])
     if not inputs:
         inputs = [ensure_demo()]

@@ -10,7 +10,14 @@ from typing import Annotated
 import typer
 from rich.table import Table
 
-from rgbd_eval.cli.common import CLUSTER_HELP, ConfigOption, SetOption, console, handle_errors
+from rgbd_eval.cli.common import (
+    CLUSTER_HELP,
+    ConfigOption,
+    SetOption,
+    console,
+    handle_errors,
+    with_threshold,
+)
 from rgbd_eval.config import load_config
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.outdir import OutputFolder
@@ -66,10 +73,10 @@ def score(
     from rgbd_eval.scoring import score_sequence, table_rows, write_report
 
     sets = list(overrides or [])
-    for key, value in (("gating", gating), ("threshold", threshold), ("convention", convention)):
+    for key, value in (("gating", gating), ("convention", convention)):
         if value is not None:
             sets.append(f"evaluation.{key}={value}")
-    config = load_config(config_file, sets)
+    config = with_threshold(load_config(config_file, sets), threshold)
     try:
         rules = Benchmark(benchmark)
     except ValueError as err:
