@@ -169,3 +169,75 @@ def test_threshold_outside_its_gating_range_is_a_usage_error(tmp_path: Path) -> 
         assert "Invalid value for '--threshold'" in result.output
     result = runner.invoke(app, [*base, "--gating", "iou", "--threshold", "1"])
     assert result.exit_code == 0, result.output
+
+
+# Issue 28: MOTChallenge text counts frames from 1, our CSV sidecar from 0 (the recording's
+# frame index). Five recording frames, 0..4. Person 1 walks right 20 px a frame with a
+# 10 px wide box, so a box one frame off overlaps nothing (IoU 0).
+SIDECAR = "frame,stamp_ns,id,bb_left,bb_top,bb_width,bb_height,x,y,z,visibility,ignore\n" + "".join(
+    f"{k},0,1,{20 * k},0,10,10,,,,1,0\n" for k in range(5)
+)
+# The tracker, in MOTChallenge frames 1..5 (recording frames 0..4): track 7 follows person 1
+# exactly in MOT frames 1-4 and loses it in 5; track 9 is a false alarm in MOT frame 5.
+MOT_FROM_1 = "".join(f"{f},7,{20 * (f - 1)},0,10,10,1,-1,-1,-1\n" for f in range(1, 5)) + (
+    "5,9,500,0,10,10,1,-1,-1,-1\n"
+)
+# By hand, frames mapped (MOT f = recording f - 1): 5 frames, 5 ground-truth instances,
+# 4 matches (frames 0-3), FN 1 (frame 4, track lost), FP 1 (track 9).
+# Off by one (MOT f taken as recording f), as before the fix: frames 0..5, 6 of them;
+# frame 0 has no track (FN); in 1-4 track 7 is 20 px behind the person (FN + FP each);
+# track 9 is a FP in a frame 5 the recording does not have; so FN 5, FP 5, no match.
+
+
+def test_mot_tracks_against_the_sidecar_map_frame_bases(tmp_path: Path) -> None:
+    gt, tracks = tmp_path / "rec.gt.csv", tmp_path / "tracks.txt"
+    gt.write_text(SIDECAR)
+    tracks.write_text(MOT_FROM_1)
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    seq = json.loads((out / "report.json").read_text())["sequences"][0]
+    c = seq["counts"]
+    assert seq["frames"] == 5
+    assert (c["num_gt"], c["num_matches"], c["fn"], c["fp"], c["id_switches"]) == (5, 4, 1, 1, 0)
+    # events.csv numbers frames as the ground truth does (the sidecar: from 0).
+    with (out / "tracks.events.csv").open() as handle:
+        rows = list(csv.DictReader(handle))
+    assert sorted({int(r["frame"]) for r in rows}) == [0, 1, 2, 3, 4]
+    assert [(r["frame"], r["event"]) for r in rows if r["event"] != "match"] == [
+        ("4", "miss"),
+        ("4", "fp"),
+    ]
+
+
+def test_our_tracks_csv_against_mot_ground_truth_map_frame_bases(tmp_path: Path) -> None:
+    """The other way round: a run's tracks.csv (from 0) scored against MOT gt.txt (from 1)."""
+    gt, tracks = tmp_path / "gt.txt", tmp_path / "seq.tracks.csv"
+    # gt.txt: person 1 in MOT frames 1..3 at x = 20 (f - 1), MOT17 columns.
+    gt.write_text("".join(f"{f},1,{20 * (f - 1)},0,10,10,1,1,1.0\n" for f in (1, 2, 3)))
+    header = "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z\n"
+    # tracks.csv: recording frames 0..2, exactly on the person: 3 matches, nothing else.
+    tracks.write_text(header + "".join(f"{k},4,{20 * k},0,10,10,-1,1,1,1\n" for k in (0, 1, 2)))
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    seq = json.loads((out / "report.json").read_text())["sequences"][0]
+    c = seq["counts"]
+    assert seq["frames"] == 3
+    assert (c["num_gt"], c["num_matches"], c["fn"], c["fp"]) == (3, 3, 0, 0)
+
+
+def test_mot_text_with_a_frame_0_is_refused(tmp_path: Path) -> None:
+    gt, tracks = _write(tmp_path)
+    zero = tmp_path / "zero.txt"
+    zero.write_text("0,7,0,0,10,10,-1,-1,-1,-1\n" + TRACKS)
+    result = runner.invoke(app, ["score", str(zero), "--gt", str(gt), "--out", str(tmp_path / "a")])
+    assert result.exit_code == 3, result.output
+    assert "frames count from 1" in result.output
+    zero_gt = tmp_path / "zero_gt.txt"
+    zero_gt.write_text("0,1,0,0,10,10,1,1,1.0\n" + GT)
+    result = runner.invoke(
+        app, ["score", str(tracks), "--gt", str(zero_gt), "--out", str(tmp_path / "b")]
+    )
+    assert result.exit_code == 5, result.output
+    assert "frames count from 1" in result.output

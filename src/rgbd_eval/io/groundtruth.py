@@ -4,13 +4,16 @@ Sidecar CSV (MOTChallenge style, extended with world coordinates)::
 
     frame,stamp_ns,id,bb_left,bb_top,bb_width,bb_height,x,y,z,visibility,ignore
 
-Empty box fields mean "no box", empty x/y/z mean "no world position"; ``ignore``
-is 0/1 and may be omitted (then 0).
+``frame`` is the recording's frame index, from 0; empty box fields mean "no box",
+empty x/y/z mean "no world position"; ``ignore`` is 0/1 and may be omitted (then 0).
 
 KTP text (Kinect Tracking Precision dataset), one line per frame::
 
     <stamp seconds>: id x y w h, id x y w h, ...     (2D boxes)
     <stamp seconds>: id x y z, id x y z, ...         (3D positions; 0 0 0 = missing)
+
+(a line's frame index is its position among the frame lines, from 0). Frames count from
+0 in every :class:`GroundTruth`, whatever the file's own numbering (``first_frame``).
 """
 
 from __future__ import annotations
@@ -54,7 +57,9 @@ class GroundTruth:
 
     source: str
     frames: tuple[tuple[int, int, tuple[GroundTruthObject, ...]], ...]
-    """Per annotated frame: (frame index, stamp_ns, objects)."""
+    """Per annotated frame: (frame index from 0, stamp_ns, objects)."""
+    first_frame: int = 0
+    """The number the source file gives its first frame (MOTChallenge text: 1), for reports."""
 
     @property
     def num_objects(self) -> int:
@@ -108,8 +113,10 @@ class GroundTruth:
         return out, unmatched
 
 
-def _group(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
-    """Group objects by frame, rejecting contradictions."""
+def _group(
+    source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0
+) -> GroundTruth:
+    """Group objects by frame (indices from 0), rejecting contradictions."""
     by_frame: dict[int, list[GroundTruthObject]] = {}
     stamps: dict[int, int] = {}
     for o in objects:
@@ -128,7 +135,8 @@ def _group(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
         if stamps[f] != 0 and stamps[f] == prev:
             raise GroundTruthError(source, f"two frames share stamp {stamps[f]}")
         prev = stamps[f]
-    return GroundTruth(source, tuple((f, stamps[f], tuple(by_frame[f])) for f in order))
+    frames = tuple((f, stamps[f], tuple(by_frame[f])) for f in order)
+    return GroundTruth(source, frames, first_frame)
 
 
 # ----------------------------------------------------------------------------- CSV
@@ -345,9 +353,14 @@ def objects_from_message(msg: Any, frame: int, stamp_ns: int) -> list[GroundTrut
     return out
 
 
-def from_objects(source: str, objects: Iterable[GroundTruthObject]) -> GroundTruth:
-    """Group already decoded objects (e.g. from the ground-truth topic)."""
-    return _group(source, objects)
+def from_objects(
+    source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0
+) -> GroundTruth:
+    """Group already decoded objects (frames from 0; e.g. from the ground-truth topic).
+
+    ``first_frame`` is the number their source gave the first frame (kept for reports).
+    """
+    return _group(source, objects, first_frame)
 
 
 def load_ground_truth(path: Path) -> GroundTruth:

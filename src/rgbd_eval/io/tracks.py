@@ -16,6 +16,12 @@ dropping tracks. MOT15 ground truth (no class column) is scored except rows whos
 consider flag is 0. Other
 ground truth goes through :func:`rgbd_eval.io.groundtruth.load_ground_truth`
 (our CSV sidecar, KTP).
+
+Frame numbers: every reader converts its format's numbering to one convention, the
+recording's frame index from 0 (as the CSV sidecar, KTP, ``tracks.csv`` and tracks in a bag
+count). MOTChallenge text counts from 1 (:data:`MOT_FIRST_FRAME`): its frame ``f`` is
+index ``f - 1``, and a frame below 1 is refused. Reports number frames as the ground-truth
+file does (``GroundTruth.first_frame``).
 """
 
 from __future__ import annotations
@@ -46,6 +52,8 @@ class Benchmark(enum.Enum):
 
 
 _PEDESTRIAN = 1
+#: The number MOTChallenge text gives the first frame (its readers subtract it).
+MOT_FIRST_FRAME = 1
 _DISTRACTORS = {
     Benchmark.MOT16: frozenset({2, 7, 8, 12}),
     Benchmark.MOT17: frozenset({2, 7, 8, 12}),
@@ -123,6 +131,12 @@ def _mot_rows(path: Path, what: type[Exception]) -> np.ndarray:
         )
     if rows.size and not np.isfinite(rows[:, :6]).all():
         raise InputError(path, "non-finite frame, id or box value")
+    if rows.size and rows[:, 0].min() < MOT_FIRST_FRAME:
+        message = (
+            f"frame {rows[:, 0].min():g}: MOTChallenge frames count from {MOT_FIRST_FRAME} "
+            "(a file numbered from 0 would be scored one frame off)"
+        )
+        raise GroundTruthError(path, message) if what is GroundTruthError else what(path, message)
     return rows
 
 
@@ -150,7 +164,7 @@ def read_mot_tracks(path: Path) -> TrackerOutput:
         x, y, z = (float(v) for v in row[7:10]) if world else (math.nan,) * 3
         if row[4] < 0 or row[5] < 0:
             raise InputError(path, f"frame {int(row[0])} id {int(row[1])}: negative box size")
-        by_frame.setdefault(int(row[0]), []).append(
+        by_frame.setdefault(int(row[0]) - MOT_FIRST_FRAME, []).append(
             TrackOutput(
                 track_id=int(row[1]),
                 x=x,
@@ -182,7 +196,7 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
         raise GroundTruthError(path, f"{rules.value} ground truth needs the class column (8)")
     objects = []
     for row in rows:
-        frame, oid = int(row[0]), int(row[1])
+        frame, oid = int(row[0]) - MOT_FIRST_FRAME, int(row[1])
         ignore, distractor, visibility = False, True, 1.0
         world = None
         if rules is Benchmark.MOT15:
@@ -209,7 +223,7 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
                 distractor=distractor,
             )
         )
-    return from_objects(str(path), objects)
+    return from_objects(str(path), objects, first_frame=MOT_FIRST_FRAME)
 
 
 # ----------------------------------------------------------------------------- tracks.csv, KTP
@@ -345,12 +359,12 @@ def _by_frame_number(gt: GroundTruth, tracks: TrackerOutput, length: int | None)
     gt_frames = {f: list(objs) for f, _, objs in gt.frames}
     track_frames = {f: list(t) for f, _, t in tracks.frames}
     numbers = set(gt_frames) | set(track_frames)
-    first = 1 if length is not None else min(numbers, default=0)
+    first = 0 if length is not None else min(numbers, default=0)
     last = max(max(numbers, default=0), first + length - 1 if length is not None else 0)
     timeline = range(first, last + 1) if numbers or length else range(0)
     return Aligned(
         stamps_ns=tuple(0 for _ in timeline),
-        frame_numbers=tuple(timeline),
+        frame_numbers=tuple(f + gt.first_frame for f in timeline),
         gt=[gt_frames.get(f, []) for f in timeline],
         tracks=[track_frames.get(f, []) for f in timeline],
         unmatched_track_frames=0,
@@ -362,8 +376,9 @@ def align(
 ) -> Aligned:
     """Put ground truth and tracks on one timeline.
 
-    When either side has no stamps (all 0) both are matched by frame number, over
-    every frame from the first to the last (or ``length`` frames from 1). Otherwise
+    When either side has no stamps (all 0) both are matched by frame index (each
+    reader counts from 0, see the module docstring), over every frame from the first
+    to the last (or the ``length`` frames of the sequence). Otherwise
     the annotated frames are the timeline and each tracker frame goes to the
     annotated frame nearest in stamp within ``max_gap_ns``; tracker frames with no
     annotated frame that near are counted in ``unmatched_track_frames``.
@@ -385,7 +400,7 @@ def align(
             unmatched += 1
     return Aligned(
         stamps_ns=tuple(int(s) for s in stamps),
-        frame_numbers=tuple(f for f, _, _ in gt.frames),
+        frame_numbers=tuple(f + gt.first_frame for f, _, _ in gt.frames),
         gt=[list(objs) for _, _, objs in gt.frames],
         tracks=out,
         unmatched_track_frames=unmatched,
