@@ -113,9 +113,7 @@ class GroundTruth:
         return out, unmatched
 
 
-def _group(
-    source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0
-) -> GroundTruth:
+def _group(source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0) -> GroundTruth:
     """Group objects by frame (indices from 0), rejecting contradictions."""
     by_frame: dict[int, list[GroundTruthObject]] = {}
     stamps: dict[int, int] = {}
