@@ -203,6 +203,7 @@ def test_each_type_round_trips(tmp_path: Path, msgtype: str, suffix: str) -> Non
 def test_topic_must_be_chosen_when_several(tmp_path: Path) -> None:
     path = tmp_path / "two.mcap"
     with RecordingWriter(path) as w:
+        w.write_static_transform(T0, "odom", "base_link", Pose(SHIFT))
         for topic, msgtype in (("/a", PEOPLE_TYPE), ("/b", OPT_TYPE)):
             w.write_message(topic, msgtype, T0, _message(w, msgtype, T0, TRACKS[0]))
     with pytest.raises(InputError, match="expected one topic"):
@@ -237,3 +238,55 @@ def test_score_a_bag_against_world_ground_truth(tmp_path: Path) -> None:
         0,
         0,
     )
+
+
+def _world_gt(path: Path) -> Path:
+    """Ground truth exactly at the tracks' positions as written (no shift)."""
+    write_csv(
+        path,
+        [
+            GroundTruthObject(k, T0 + k * PERIOD, 10 * i, None, (x, y, 0.9))
+            for k, tracks in enumerate(TRACKS)
+            for i, x, y in tracks
+        ],
+    )
+    return path
+
+
+def _write_in(path: Path, frame_id: str) -> Path:
+    """opt_msgs/TrackArray in ``frame_id``, and no /tf at all."""
+    with RecordingWriter(path) as w:
+        for k, tracks in enumerate(TRACKS):
+            msg = _message(w, OPT_TYPE, T0 + k * PERIOD, tracks)
+            msg.header.frame_id = frame_id
+            w.write_message("/tracks", OPT_TYPE, T0 + k * PERIOD, msg)
+    return path
+
+
+def test_tracks_with_no_tf_to_the_ground_truths_frame_are_refused(tmp_path: Path) -> None:
+    """Issue 28: tracks in 'world' with no /tf were scored as they are (MOTA -106 %)."""
+    bag, gt = _write_in(tmp_path / "world.bag", "world"), _world_gt(tmp_path / "gt.csv")
+    base = ["score", str(bag), "--gt", str(gt), "--gating", "metric"]
+    result = CliRunner().invoke(app, [*base, "--out", str(tmp_path / "a")])
+    assert result.exit_code == 3, result.output
+    message = " ".join(result.output.split())
+    assert message.startswith(f"error: {bag} [/tracks]: "), message
+    assert "tracks' frame 'world'" in message and "ground truth's frame 'odom'" in message
+    assert "no tf chain from 'odom' to 'world'" in message and "io.world_frame" in message
+    assert not (tmp_path / "a").exists()
+    # Saying the ground truth is in 'world' scores them: all 4 match.
+    out = tmp_path / "b"
+    result = CliRunner().invoke(app, [*base, "--set", "io.world_frame=world", "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    import json
+
+    counts = json.loads((out / "report.json").read_text())["sequences"][0]["counts"]
+    assert (counts["num_matches"], counts["fp"], counts["fn"]) == (4, 0, 0)
+
+
+def test_tracks_in_the_default_world_frame_need_no_tf(tmp_path: Path) -> None:
+    # 'odom' is io.world_frame's default: tracks already there are read as they are.
+    out = read_bag_tracks(_write_in(tmp_path / "odom.bag", "odom"))
+    assert [(t.x, t.y) for t in out.frames[0][2]] == [(1.0, 0.0), (4.0, -1.0)]
+    with pytest.raises(InputError, match="tracks' frame 'odom'"):
+        read_bag_tracks(tmp_path / "odom.bag", world_frame="map")

@@ -14,10 +14,11 @@ that embed their definitions are read with those):
   ``visibility`` and the 2D box where its width is positive.
 
 World positions are brought from the message's ``header.frame_id`` into the
-target frame through the recording's ``/tf`` and ``/tf_static``, at the header
-stamp. The target is ``io.world_frame`` when set, else the first of ``map``,
-``odom``, ``world`` in the tf tree (as ``rgbd-eval run`` chooses), else the
-messages' own frame.
+ground truth's frame through the recording's ``/tf`` and ``/tf_static``, at the
+header stamp. The ground truth's frame is ``io.world_frame`` when set, else the
+first of ``map``, ``odom``, ``world`` in the tf tree (as ``rgbd-eval run`` chooses),
+else ``odom`` (``io.world_frame``'s default). Positions in another frame with no tf
+to it are refused (:class:`TransformError`, exit 3), never scored as they are.
 """
 
 from __future__ import annotations
@@ -113,6 +114,20 @@ def _decode(msgtype: str, msg: Any, ids: _Ids) -> list[_Raw]:
     return out
 
 
+#: ``io.world_frame``'s default where the recording does not name a world frame.
+DEFAULT_WORLD_FRAME = "odom"
+
+
+def _target_frame(world_frame: str | None, tf: TfBuffer) -> tuple[str, str]:
+    """The ground truth's frame (see the module docstring) and where that choice came from."""
+    if world_frame and world_frame.lstrip("/"):
+        return world_frame.lstrip("/"), "io.world_frame"
+    found = next((f for f in ("map", "odom", "world") if f in tf.frames), None)
+    if found is not None:
+        return found, "the world frame of the recording's tf"
+    return DEFAULT_WORLD_FRAME, "io.world_frame's default: the recording's tf names no world frame"
+
+
 def read_bag_tracks(
     path: Path, topic: str | None = None, world_frame: str | None = None
 ) -> TrackerOutput:
@@ -156,22 +171,21 @@ def read_bag_tracks(
             except ValueError as err:
                 raise InputError(path, str(err), topic) from err
             frames.append((_stamp(msg), msg.header.frame_id.lstrip("/"), decoded))
-    target = (world_frame or "").lstrip("/") or next(
-        (f for f in ("map", "odom", "world") if f in tf.frames), ""
-    )
+    target, why = _target_frame(world_frame, tf)
     out = []
     for index, (stamp, frame_id, decoded) in enumerate(sorted(frames, key=lambda f: f[0])):
         pose: Pose | None = None
-        if (
-            target
-            and frame_id
-            and frame_id != target
-            and any(p is not None for _, p, *_ in decoded)
-        ):
+        if frame_id != target and any(p is not None for _, p, *_ in decoded):
             try:
                 pose = tf.lookup(target, frame_id, stamp, tolerance_ns=200_000_000)
             except TransformLookupError as err:
-                raise TransformError(path, f"{frame_id} -> {target}: {err}", topic) from err
+                raise TransformError(
+                    path,
+                    f"no transform from the tracks' frame {frame_id!r} to the ground truth's "
+                    f"frame {target!r} ({why}; set io.world_frame to the ground truth's frame "
+                    f"if it is another): {err}",
+                    topic,
+                ) from err
         tracks = []
         for track_id, position, height, box, vis in decoded:
             x = y = math.nan
