@@ -261,6 +261,17 @@ def score_sequence(
     return evaluate_sequence(gt.frames, tracks, config.evaluation)
 
 
+def warmup_warnings(config: RunConfig, frames: int) -> tuple[str, ...]:
+    """A warning when every frame goes to the detector's warm-up (it then detects nothing)."""
+    warmup = detector_spec(config.detector.name).warmup(config.detector)
+    if warmup is None or frames > warmup[0]:
+        return ()
+    return (
+        f"the {config.detector.name} detector spends all {frames} frames of the recording on "
+        f"{warmup[1]} and detects nothing",
+    )
+
+
 def run_sequence(
     path: Path,
     config: RunConfig,
@@ -285,7 +296,14 @@ def run_sequence(
     return SequenceResult(
         name=sequence_name(path),
         path=str(path),
-        info=replace(recording.info, warnings=recording.info.warnings + recording.frame_warnings),
+        info=replace(
+            recording.info,
+            warnings=(
+                *recording.info.warnings,
+                *recording.frame_warnings,
+                *warmup_warnings(config, len(recording)),
+            ),
+        ),
         detections=detections,
         tracks=tracks,
         ground_truth=matched,

@@ -101,6 +101,9 @@ class DetectorSpec:
     #: Names of the stages the detector times (``last_timings``), in pipeline order.
     stages: tuple[str, ...] = ()
     summary: str = ""
+    #: The frames the detector only learns from before it can detect anything (a background
+    #: model's initialisation) and what sets them, from its config; None: it needs none.
+    warmup: Callable[[Any], tuple[int, str] | None] = field(default=lambda _c: None)
 
 
 @dataclass(frozen=True)

@@ -135,8 +135,9 @@ def markdown_table(results: Sequence[SequenceResult], gating: Gating) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run_notes(results: Sequence[SequenceResult]) -> list[str]:
-    """What a reader must know besides the table: unscored sequences and reader warnings."""
+def run_notes(results: Sequence[SequenceResult], warnings: bool = True) -> list[str]:
+    """What a reader must know besides the table: unscored sequences and (unless
+    ``warnings`` is False) the warnings of :func:`run_warnings`."""
     notes = []
     for r in results:
         if r.scores is None:
@@ -144,8 +145,14 @@ def run_notes(results: Sequence[SequenceResult]) -> list[str]:
                 f"{r.name}: no ground truth found, nothing scored "
                 f"({sum(len(d) for d in r.detections.detections)} detections and the tracks written)"
             )
-        notes += [f"{r.name}: warning: {w}" for w in r.info.warnings]
+        if warnings:
+            notes += run_warnings([r])
     return notes
+
+
+def run_warnings(results: Sequence[SequenceResult]) -> list[str]:
+    """``<name>: warning: ...`` for each warning of each sequence (reader, detector)."""
+    return [f"{r.name}: warning: {w}" for r in results for w in r.info.warnings]
 
 
 def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:

@@ -156,3 +156,26 @@ def test_threshold_outside_its_gating_range_is_a_usage_error(
         assert line.startswith("error: Invalid value for '--threshold': "), line
         assert problem in line and line.endswith("run --help)"), line
         assert not out.exists()
+
+
+def test_dmtbs_on_a_recording_shorter_than_its_background_initialisation_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 28: 5 frames, all spent on the 30-frame background initialisation, found nothing."""
+    rec = write_recording(tmp_path / "short.mcap", "mcap", Spec(n=5))
+    out = tmp_path / "out"
+    outcome = run_cli(["run", str(rec), "--method", "dmtbs", "--out", str(out), "--json"], capsys)
+    assert outcome.code == 0, outcome
+    expected = "spends all 5 frames of the recording on its background initialisation"
+    assert any(
+        line.startswith("short: warning: ") and expected in line for line in outcome.error_lines
+    ), outcome.stderr
+    (seq,) = json.loads((out / "report.json").read_text())["sequences"]
+    assert any(expected in w for w in seq["warnings"]), seq["warnings"]
+    # Shorter initialisation, no warning.
+    out2 = tmp_path / "out2"
+    args = ["run", str(rec), "--method", "dmtbs", "--set", "detector.init_frames=2"]
+    outcome = run_cli([*args, "--out", str(out2)], capsys)
+    assert outcome.code == 0 and "initialisation" not in outcome.stderr + outcome.stdout
+    (seq,) = json.loads((out2 / "report.json").read_text())["sequences"]
+    assert not any("initialisation" in w for w in seq["warnings"])

@@ -63,7 +63,7 @@ def test_some_empty_depth_frames_are_reported(
     result = run_cli(["run", str(rec), "--out", str(out)], capsys)
     assert result.code == 0, result.stderr
     warning = "2 of 4 depth frames hold no valid pixel"
-    assert warning in result.stdout
+    assert warning in result.stderr  # warnings go to stderr (issue 28)
     assert any(
         warning in w
         for w in json.loads((out / "report.json").read_text())["sequences"][0]["warnings"]
@@ -174,7 +174,7 @@ def test_a_damaged_ros1_message_is_skipped_counted_and_reported(
     result = run_cli(["run", str(rec), "--out", str(out)], capsys)
     assert result.code == 0, result.stderr
     warning = f"damaged messages skipped: {topic} 1 of {FRAMES} ("
-    assert warning in result.stdout and problem in result.stdout
+    assert warning in result.stderr and problem in result.stderr
     seq = json.loads((out / "report.json").read_text())["sequences"][0]
     assert [(s["topic"], s["count"], s["total"]) for s in seq["skipped_messages"]] == [
         (topic, 1, FRAMES)

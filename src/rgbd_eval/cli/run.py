@@ -91,7 +91,7 @@ def print_table(results: list[SequenceResult], config: RunConfig) -> None:
         for row in table_rows(results, config.evaluation.gating):
             table.add_row(*row, style="bold" if row[0] == "overall" else None)
         console.print(table)
-    for note in run_notes(results):
+    for note in run_notes(results, warnings=False):
         console.print(note)
 
 
@@ -137,7 +137,7 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
-    from rgbd_eval.report import REPORT_FILE, write_run
+    from rgbd_eval.report import REPORT_FILE, run_warnings, write_run
     from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
@@ -191,3 +191,5 @@ def run(
             f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
             f"(machine-readable: {out_dir / 'report.json'})"
         )
+    for line in run_warnings(results):  # also in report.json: each sequence's "warnings"
+        err_console.print(line, markup=False, highlight=False, soft_wrap=True)

@@ -349,5 +349,9 @@ SPEC = register_detector(
         stages=STAGES,
         summary="background subtraction, density map, blobs; 1..N static depth cameras "
         "(seed 003, section 3)",
+        warmup=lambda c: (
+            c.init_frames,
+            f"its background initialisation (detector.init_frames={c.init_frames})",
+        ),
     )
 )
