@@ -153,10 +153,14 @@ def test_an_ambiguous_mono16_topic_is_not_guessed(tmp_path: Path) -> None:
     assert rec.info.selected.streams == {"thermal": "/cam/image_raw"}
 
 
-def test_registered_depth_without_its_own_camera_info(tmp_path: Path) -> None:
-    """depth_registered/image with only rgb/camera_info: the colour model, and a warning."""
-    path = tmp_path / "registered.bag"
-    cam = CameraModel(32, 24, 26.25, 26.25, 15.5, 11.5, (0.0,) * 5, "camera_rgb_optical_frame")
+REGISTERED_CAM = CameraModel(
+    32, 24, 26.25, 26.25, 15.5, 11.5, (0.0,) * 5, "camera_rgb_optical_frame"
+)
+
+
+def _registered(path: Path) -> Path:
+    """depth_registered/image_raw without a CameraInfo of its own, and rgb/image_rect_color."""
+    cam = REGISTERED_CAM
     with RecordingWriter(path, "ros1") as w:
         for i in range(2):
             s = T0 + i * PERIOD
@@ -166,6 +170,12 @@ def test_registered_depth_without_its_own_camera_info(tmp_path: Path) -> None:
             w.write_image(
                 "/camera/depth_registered/image_raw", "/other/info", s, depth, cam, "16UC1"
             )
+    return path
+
+
+def test_registered_depth_without_its_own_camera_info(tmp_path: Path) -> None:
+    """depth_registered/image with only rgb/camera_info: the colour model, and a warning."""
+    path = _registered(tmp_path / "registered.bag")
     rec = open_recording(path)
     assert rec.info.cameras["depth"] == rec.info.cameras["colour"]
     assert any("registered to the colour image" in w for w in rec.info.warnings)
@@ -182,3 +192,39 @@ def test_no_pair_names_the_smallest_offset_and_the_option(tmp_path: Path) -> Non
     with pytest.raises(SyncError, match=r"smallest offset is 200\.0 ms.*io\.max_sync_gap_ms=201"):
         open_recording(path)
     assert len(open_recording(path, IoConfig(max_sync_gap_ms=201)).frame_stamps) == 1
+
+
+@pytest.mark.parametrize("method", ["basso2012", "pinto2022", "dmtbs"])
+def test_every_method_takes_the_colour_model_for_a_registered_depth_image(
+    tmp_path: Path, method: str
+) -> None:
+    """Issue 28: dmtbs (depth only) refused what basso2012 and pinto2022 accept."""
+    from rgbd_eval.config import load_config
+    from rgbd_eval.pipeline import open_for
+
+    rec = open_for(_registered(tmp_path / "registered.bag"), load_config(method=method))
+    assert rec.info.cameras["depth"] == REGISTERED_CAM
+    warning = (
+        "/camera/depth_registered/image_raw has no CameraInfo of its own: registered to the "
+        "colour image (/camera/rgb/camera_info), whose camera model it takes"
+    )
+    assert warning in rec.info.warnings
+    assert len(list(rec.frames())) == 2
+
+
+def test_a_depth_image_unlike_the_colour_camera_keeps_needing_its_camera_info(
+    tmp_path: Path,
+) -> None:
+    """Another frame id than the colour image's: not registered, refused for every method."""
+    path = tmp_path / "unregistered.bag"
+    with RecordingWriter(path, "ros1") as w:
+        put(w, "/camera/rgb/image_rect_color", T0, rgb_image(0)[:24, :32], REGISTERED_CAM, "rgb8")
+        w.write_image(
+            "/camera/depth/image_raw", "/other/info", T0, depth_image(0), DEPTH_CAM, "16UC1"
+        )
+    for streams in (
+        (StreamSpec("colour"), StreamSpec("depth")),
+        (StreamSpec("depth", multiple=True),),
+    ):
+        with pytest.raises(TopicError, match="no CameraInfo for this image topic"):
+            open_recording(path, streams=streams)

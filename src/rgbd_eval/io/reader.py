@@ -91,6 +91,9 @@ class SelectedTopics:
     ground_truth: str | None
     #: JointState of the wheels, integrated into odometry (``io.wheels``).
     joint_states: str | None = None
+    #: The colour image topic and its CameraInfo whose camera model a depth image without
+    #: CameraInfo of its own may take (registered depth), whether or not colour is read.
+    registration: tuple[str, str] | None = None
 
     @property
     def rgb(self) -> str | None:
@@ -565,6 +568,34 @@ def _info_for(image_topic: str, infos: list[str], override: str | None) -> str |
     return same[0] if len(same) == 1 else None
 
 
+def _registration(
+    chosen: Mapping[str, str],
+    info_topics: Mapping[str, str],
+    first: Mapping[str, Any],
+    infos: list[str],
+    io: IoConfig,
+) -> tuple[str, str] | None:
+    """The colour camera a depth image without CameraInfo of its own may be registered to.
+
+    One rule for every method: the colour stream when the method reads one, else the
+    recording's colour topic (``io.topics.colour``, or the only one), with its CameraInfo.
+    None when no depth stream lacks CameraInfo, or there is no such colour camera.
+    """
+    if all(r in info_topics for r in chosen if role_kind(r) == "depth"):
+        return None
+    if "colour" in chosen:
+        topic: str | None = chosen["colour"]
+        info = info_topics.get("colour")
+    else:
+        colours = [t for t in sorted(first) if image_kinds(t, first[t]) == ("colour",)]
+        named = io.topic("colour")
+        if named is not None:
+            colours = [named] if named in first else []
+        topic = colours[0] if len(colours) == 1 else None
+        info = None if topic is None else _info_for(topic, infos, io.topic("colour_info"))
+    return (topic, info) if topic is not None and info is not None else None
+
+
 def open_recording(
     path: Path | str,
     io: IoConfig | None = None,
@@ -656,7 +687,13 @@ def open_recording(
                 path, "ground_truth", "ground-truth", io.topic("ground_truth"), gts, False
             )
             selected = SelectedTopics(
-                chosen, info_topics, odom_topic, tf_topics, gt_topic, joint_topic
+                chosen,
+                info_topics,
+                odom_topic,
+                tf_topics,
+                gt_topic,
+                joint_topic,
+                _registration(chosen, info_topics, first, infos, io),
             )
             index = _index_pass(path, src, selected, io)
     except READ_ERRORS as err:
@@ -877,7 +914,7 @@ def _rate(stamps: list[int] | None) -> float | None:
 def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfig) -> _Index:
     index = _Index()
     images_ = set(sel.streams.values())
-    infos = set(sel.infos.values())
+    infos = set(sel.infos.values()) | ({sel.registration[1]} if sel.registration else set())
     small = {t for t in (sel.odometry, sel.ground_truth, sel.joint_states) if t} | infos
     odometer = wheels.WheelOdometry(0.5 * io.wheels.separation_m) if io.wheels is not None else None
     small.update(sel.tf)
@@ -984,7 +1021,8 @@ def _cameras(
 
     A depth image without CameraInfo of its own that has the colour image's frame id
     and size is registered to it (``depth_registered`` topics): it takes the colour
-    camera's model, with a warning.
+    camera's model (:attr:`SelectedTopics.registration`, also when the method reads no
+    colour images), with a warning.
     """
     cameras: dict[str, CameraModel] = {}
     order = sorted(sel.streams, key=lambda r: r in sel.infos, reverse=True)  # own info first
@@ -1000,7 +1038,7 @@ def _cameras(
                 info_topic,
             )
         if msg is None:
-            colour = cameras.get("colour")
+            colour = _registered_camera(path, sel, index, first, cameras)
             img = first[topic]
             left = cameras.get("left")
             if role_kind(role) == "disparity" and left is not None:
@@ -1026,7 +1064,8 @@ def _cameras(
             ):
                 warnings.append(
                     f"{topic} has no CameraInfo of its own: registered to the colour image "
-                    f"({sel.infos.get('colour')}), whose camera model it takes"
+                    f"({sel.registration[1] if sel.registration else None}), whose camera "
+                    "model it takes"
                 )
                 cameras[role] = colour
                 continue
@@ -1037,6 +1076,23 @@ def _cameras(
             )
         cameras[role] = _camera(path, info_topic, msg, first[topic], topic)
     return {role: cameras[role] for role in sel.streams}
+
+
+def _registered_camera(
+    path: Path,
+    sel: SelectedTopics,
+    index: _Index,
+    first: Mapping[str, Any],
+    cameras: Mapping[str, CameraModel],
+) -> CameraModel | None:
+    """The model of the colour camera of :attr:`SelectedTopics.registration`, if usable."""
+    if sel.registration is None:
+        return None
+    if "colour" in cameras:  # read by the method: its model, from the same CameraInfo
+        return cameras["colour"]
+    topic, info_topic = sel.registration
+    msg = index.first_msgs.get(info_topic)
+    return None if msg is None else _camera(path, info_topic, msg, first[topic], topic)
 
 
 def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str) -> CameraModel:
