@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from typing import Any
 
 from typer.testing import CliRunner
 
@@ -189,14 +190,20 @@ MOT_FROM_1 = "".join(f"{f},7,{20 * (f - 1)},0,10,10,1,-1,-1,-1\n" for f in range
 # track 9 is a FP in a frame 5 the recording does not have; so FN 5, FP 5, no match.
 
 
+def _scored(tracks: Path, gt: Path, out: Path) -> dict[str, Any]:
+    """``score TRACKS --gt GT``: the report's one sequence."""
+    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    sequence: dict[str, Any] = json.loads((out / "report.json").read_text())["sequences"][0]
+    return sequence
+
+
 def test_mot_tracks_against_the_sidecar_map_frame_bases(tmp_path: Path) -> None:
     gt, tracks = tmp_path / "rec.gt.csv", tmp_path / "tracks.txt"
     gt.write_text(SIDECAR)
     tracks.write_text(MOT_FROM_1)
     out = tmp_path / "out"
-    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    seq = json.loads((out / "report.json").read_text())["sequences"][0]
+    seq = _scored(tracks, gt, out)
     c = seq["counts"]
     assert seq["frames"] == 5
     assert (c["num_gt"], c["num_matches"], c["fn"], c["fp"], c["id_switches"]) == (5, 4, 1, 1, 0)
@@ -218,10 +225,7 @@ def test_our_tracks_csv_against_mot_ground_truth_map_frame_bases(tmp_path: Path)
     header = "frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z\n"
     # tracks.csv: recording frames 0..2, exactly on the person: 3 matches, nothing else.
     tracks.write_text(header + "".join(f"{k},4,{20 * k},0,10,10,-1,1,1,1\n" for k in (0, 1, 2)))
-    out = tmp_path / "out"
-    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
-    assert result.exit_code == 0, result.output
-    seq = json.loads((out / "report.json").read_text())["sequences"][0]
+    seq = _scored(tracks, gt, tmp_path / "out")
     c = seq["counts"]
     assert seq["frames"] == 3
     assert (c["num_gt"], c["num_matches"], c["fn"], c["fp"]) == (3, 3, 0, 0)
