@@ -182,3 +182,23 @@ def test_no_pair_names_the_smallest_offset_and_the_option(tmp_path: Path) -> Non
     with pytest.raises(SyncError, match=r"smallest offset is 200\.0 ms.*io\.max_sync_gap_ms=201"):
         open_recording(path)
     assert len(open_recording(path, IoConfig(max_sync_gap_ms=201)).frame_stamps) == 1
+
+
+def test_streams_that_pair_on_no_common_frame(tmp_path: Path) -> None:
+    # Depth pairs with the first two colour frames only, thermal with the last two only.
+    path = tmp_path / "apart.mcap"
+    with RecordingWriter(path, "mcap") as w:
+        for i in range(4):
+            s = T0 + i * 200_000_000
+            put(w, "/camera/rgb/image_color", s, rgb_image(i), RGB_CAM, "rgb8")
+            if i < 2:
+                put(w, "/camera/depth/image_raw", s + 1_000_000, depth_image(i), DEPTH_CAM, "16UC1")
+            else:
+                put(w, "/thermal/image_raw", s + 1_000_000, thermal_image(i), THERMAL_CAM, "mono16")
+    streams = (StreamSpec("colour"), StreamSpec("depth"), StreamSpec("thermal"))
+    with pytest.raises(SyncError, match="no frame has every stream within the sync gap"):
+        open_recording(path, streams=streams)
+    rec = open_recording(path, streams=streams, unpaired_ok=True)
+    assert len(rec) == 0
+    (problem,) = rec.info.sync.problems
+    assert problem.role is None and "no frame has every stream" in problem.message
