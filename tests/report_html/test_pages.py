@@ -182,6 +182,28 @@ def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) 
     assert not (pages["score"].parent / "tracks.birdseye.png").exists()
 
 
+def test_score_page_tables(pages: dict[str, Path], score_dir: Path) -> None:
+    import json
+
+    html = pages["score"].read_text()
+    # Metrics: FP and FN with their counts; person 1 matched in 3 of 4 frames: partly tracked.
+    assert "<th>FP</th><th>FN</th>" in html and "<th>MT</th><th>PT</th><th>ML</th>" in html
+    assert "<td>25.0% (1)</td><td>25.0% (1)</td>" in html
+    assert "<td>0</td><td>1</td><td>0</td>" in html  # MT, PT, ML
+    # Inputs: each file on its own line with its own checksum.
+    seq = json.loads((score_dir / "report.json").read_text())["sequences"][0]
+    lines = {
+        m[0]: m[1]
+        for m in re.findall(
+            r'<td class="left mono">([0-9a-f]{64})</td><td class="left mono">([^<]*)</td>', html
+        )
+    }
+    assert lines == {
+        seq["tracks_sha256"]: seq["path"],
+        seq["sha256"]: seq["ground_truth"]["source"],
+    }
+
+
 def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidence() -> None:
     # basso2012's ReproduceResult names each claim by the thesis' sentence; the page still
     # finds its source and evidence in the JSON data.
