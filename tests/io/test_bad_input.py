@@ -243,7 +243,7 @@ def test_inspect_reports_colour_and_depth_that_do_not_pair(
     (problem,) = rec["sync"]["problems"]
     assert problem["role"] == "depth"
     assert problem["smallest_gap_ms"] == pytest.approx(113.0)
-    assert problem["largest_gap_ms"] == pytest.approx(336.0)
+    assert problem["needed_gap_ms"] == pytest.approx(336.0)
     assert problem["option"] == "io.max_sync_gap_ms"
     assert problem["accept_with"] == "--set io.max_sync_gap_ms=337"
     assert problem["pairs_accepted"] == 4

@@ -108,7 +108,7 @@ def _print_human(data: dict[str, Any]) -> None:
         if st["role"] == s["reference"]:
             gap = ""
         elif (p := unpaired.get(st["role"])) is not None and p["smallest_gap_ms"] is not None:
-            gap = f", none paired (offsets {p['smallest_gap_ms']:.1f} to {p['largest_gap_ms']:.1f} ms)"
+            gap = f", none paired (smallest offset {p['smallest_gap_ms']:.1f} ms)"
         elif st["role"] in unpaired:
             gap = ", none paired"
         else:

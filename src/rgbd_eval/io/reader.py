@@ -117,16 +117,17 @@ class StreamSync:
 class SyncProblem:
     """A stream none of whose messages pairs with the reference stream within the sync gap.
 
-    The gaps are each reference message's offset to its nearest message of the stream;
-    ``accept_with`` is the setting of ``option`` that covers them all, which would pair
-    ``pairs_accepted`` reference messages. Without a role: no frame has every stream.
+    ``smallest_gap_ms`` is the smallest offset between the two streams' stamps and
+    ``needed_gap_ms`` the smallest sync gap at which as many messages pair as can;
+    ``accept_with`` sets ``option`` to it, which pairs ``pairs_accepted`` reference
+    messages. Without a role: no frame has every stream.
     """
 
     message: str
     role: str | None = None
     topic: str | None = None
     smallest_gap_ms: float | None = None
-    largest_gap_ms: float | None = None
+    needed_gap_ms: float | None = None
     option: str = "io.max_sync_gap_ms"
     accept_with: str | None = None
     pairs_accepted: int | None = None
@@ -882,13 +883,11 @@ def _skip_wrong_sizes(
         index.sizes[topic] = [sizes[k] for k in keep]
 
 
-def _nearest_gaps_ns(a: NDArray[np.int64], b: NDArray[np.int64]) -> NDArray[np.int64]:
-    """Each a_i's offset to its nearest b_j, in nanoseconds (both sorted, b non-empty)."""
-    j = np.clip(np.searchsorted(b, a), 1, b.size - 1) if b.size > 1 else np.zeros(a.size, int)
-    gaps: NDArray[np.int64] = np.abs(a - b[j])
-    if b.size > 1:
-        gaps = np.minimum(gaps, np.abs(a - b[j - 1]))
-    return gaps
+def _neighbour_gaps_ns(a: NDArray[np.int64], b: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The offsets of each a_i to its neighbours in b on either side (both sorted, non-empty)."""
+    j = np.searchsorted(b, a)
+    before, after = j > 0, j < b.size
+    return np.concatenate([a[before] - b[j[before] - 1], b[j[after]] - a[after]]).astype(np.int64)
 
 
 def _unpaired(
@@ -898,26 +897,46 @@ def _unpaired(
     chosen: Mapping[str, str],
     stamps: Mapping[str, NDArray[np.int64]],
 ) -> SyncProblem:
-    """Why ``role`` pairs with no ``reference`` message, and the sync gap that would pair them."""
+    """Why ``role`` pairs with no ``reference`` message, and the sync gap that would pair them.
+
+    That gap is the smallest at which as many messages pair as at any gap: the
+    candidates :func:`pair_nearest` weighs are every stamp's neighbours in the other
+    stream, and the pairs it keeps only grow with the gap, so a bisection over those
+    neighbours' offsets finds it.
+    """
     ref, other = stamps[reference], stamps[role]
     counts = f"({chosen[reference]}: {ref.size} messages, {chosen[role]}: {other.size})"
     head = f"{reference} and {role} do not pair: no pair within {io.max_sync_gap_ms} ms {counts}"
     if ref.size == 0 or other.size == 0:
         return SyncProblem(f"{head}; a stream has no message", role, chosen[role])
-    gaps = _nearest_gaps_ns(ref, other)
-    smallest, largest = float(gaps.min()) / 1e6, float(gaps.max()) / 1e6
-    accept = math.ceil(largest + 1)
-    pairs = len(pair_nearest(ref, other, int(accept * 1e6)).pairs)
+    gaps = np.unique(
+        np.concatenate([_neighbour_gaps_ns(ref, other), _neighbour_gaps_ns(other, ref)])
+    )
+
+    def pairs_within(gap_ns: int) -> int:
+        return len(pair_nearest(ref, other, gap_ns).pairs)
+
+    most = pairs_within(int(gaps[-1]))
+    lo, hi = 0, gaps.size - 1  # the first gap at which ``most`` pair is in gaps[lo:hi + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if pairs_within(int(gaps[mid])) == most:
+            hi = mid
+        else:
+            lo = mid + 1
+    smallest, needed = float(gaps[0]) / 1e6, float(gaps[lo]) / 1e6
+    accept = math.ceil(needed + 1)
     setting = f"--set {SyncProblem.option}={accept}"
     return SyncProblem(
-        f"{head}; the smallest offset is {smallest:.1f} ms, the largest {largest:.1f} ms: "
-        f"accept them with {setting} (pairs {pairs} of {ref.size} {reference} messages)",
+        f"{head}; the smallest offset is {smallest:.1f} ms, and as many as can pair do within "
+        f"{needed:.1f} ms: accept them with {setting} (pairs {most} of {ref.size} "
+        f"{reference} messages)",
         role,
         chosen[role],
         smallest,
-        largest,
+        needed,
         accept_with=setting,
-        pairs_accepted=pairs,
+        pairs_accepted=most,
     )
 
 
