@@ -48,11 +48,14 @@ COLUMNS: tuple[tuple[str, str, str], ...] = (
     ("idf1", "IDF1", "pct"),
     ("hota", "HOTA", "pct"),
     ("mt", "MT", "int"),
+    ("pt", "PT", "int"),
     ("ml", "ML", "int"),
     ("fragmentations", "Frag.", "int"),
     ("recall_errors", "Rec. err.", "int"),
 )
 
+#: Shares whose count is shown beside them (``3.2% (41)``): the count's key in a summary.
+COUNT_OF = {"fp_rate": "fp", "fn_rate": "fn"}
 
 #: How each convention matches, for the report header.
 MATCHING = {
@@ -87,11 +90,14 @@ def library_versions() -> dict[str, str]:
 
 
 def format_value(summary: Summary | None, key: str, kind: str, gating: Gating) -> str:
-    """One table cell: percentages as in the thesis, MOTP as % (IoU) or metres."""
+    """One table cell: percentages as in the thesis (FP and FN with their counts,
+    :data:`COUNT_OF`), MOTP as % (IoU) or metres."""
     if summary is None or summary.get(key) is None:
         return "-"
     value = summary[key]
     assert value is not None
+    if kind == "pct" and (count := summary.get(COUNT_OF.get(key, ""))) is not None:
+        return f"{100.0 * float(value):.1f}% ({int(count)})"
     if kind == "pct" or (kind == "motp" and gating is Gating.IOU):
         return f"{100.0 * float(value):.1f}%"
     if kind == "motp":

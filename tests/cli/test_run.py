@@ -48,6 +48,12 @@ def test_scored_run_counts_every_ground_truth_instance(tmp_path: Path) -> None:
     assert counts["num_gt"] == 5
     assert counts["num_matches"] + counts["fn"] == 5
     assert report["overall"]["counts"] == counts
+    # report.md: FP and FN with their counts, PT beside MT and ML.
+    md = (out / "report.md").read_text()
+    metrics = report["sequences"][0]["metrics"]
+    fp_fn = f"| {100 * metrics['fp_rate']:.1f}% ({counts['fp']}) | {100 * metrics['fn_rate']:.1f}% ({counts['fn']}) |"
+    assert fp_fn in md
+    assert "| MT | PT | ML |" in md
 
 
 def test_gating_needs_matching_ground_truth(tmp_path: Path) -> None:

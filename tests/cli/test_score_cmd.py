@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import re
 from pathlib import Path
 from typing import Any
 
@@ -245,3 +246,19 @@ def test_mot_text_with_a_frame_0_is_refused(tmp_path: Path) -> None:
     )
     assert result.exit_code == 5, result.output
     assert "frames count from 1" in result.output
+
+
+def test_tables_give_fp_and_fn_counts_and_pt(tmp_path: Path) -> None:
+    gt, tracks = _write(tmp_path)
+    out = tmp_path / "out"
+    result = runner.invoke(app, ["score", str(tracks), "--gt", str(gt), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    # 2 scored instances: FP 2 (100 %), FN 0; person 1 tracked in both frames: MT 1, PT 0, ML 0.
+    lines = result.output.splitlines()
+    header = next(line for line in lines if line.lstrip().startswith("sequence"))
+    assert re.search(r" FP +FN +ID Sw\. .* MT +PT +ML +Frag\. ", header), header
+    row = next(line for line in lines if line.lstrip().startswith("tracks "))
+    assert re.search(r" 100\.0% \(2\) +0\.0% \(0\) +0 .* 1 +0 +0 +0 +0 *$", row), row
+    md = (out / "report.md").read_text()
+    assert "| FP | FN |" in md and "| MT | PT | ML |" in md
+    assert "| 100.0% (2) | 0.0% (0) |" in md

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -207,3 +208,49 @@ def test_compressed_rgb_garbage(tmp_path: Path) -> None:
     code, out = inspect(path)
     assert code == 3
     assert_one_line_error(out, "[/camera/rgb/image_color/compressed]", "could not be decoded")
+
+
+def test_inspect_reports_colour_and_depth_that_do_not_pair(
+    make_recording: Callable[..., Path],
+) -> None:
+    # A robot's snapshot recording: one colour/depth pair a second, 113 to 336 ms apart.
+    rgb = [T0 + i * 1_000_000_000 for i in range(4)]
+    offsets_ms = (113, 336, 200, 150)
+    depth = [s + ms * 1_000_000 for s, ms in zip(rgb, offsets_ms, strict=True)]
+    path = make_recording("mcap", Spec(rgb_stamps=rgb, depth_stamps=depth))
+    assert runner.invoke(app, ["run", str(path), "--out", str(path.parent / "out")]).exit_code == 3
+
+    code, out = inspect(path)
+    assert code == 0, out
+    assert "Traceback" not in out
+    for shown in ("/camera/rgb/image_color", "/camera/depth/image_raw", "colour camera: 64x48"):
+        assert shown in out, shown
+    lines = [line for line in out.splitlines() if "do not pair" in line]
+    assert len(lines) == 1, out
+    for fragment in ("colour", "depth", "113.0", "336.0", "--set io.max_sync_gap_ms=337", "4 of 4"):
+        assert fragment in lines[0], (fragment, lines[0])
+
+    result = runner.invoke(app, ["inspect", str(path), "--json"])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    rec = data["recording"]
+    assert rec["num_frames"] == 0
+    assert rec["cameras"]["depth"]["width"] == 32
+    assert {t["name"] for t in rec["topics"]} >= {
+        "/camera/rgb/image_color",
+        "/camera/depth/image_raw",
+    }
+    (problem,) = rec["sync"]["problems"]
+    assert problem["role"] == "depth"
+    assert problem["smallest_gap_ms"] == pytest.approx(113.0)
+    assert problem["needed_gap_ms"] == pytest.approx(336.0)
+    assert problem["option"] == "io.max_sync_gap_ms"
+    assert problem["accept_with"] == "--set io.max_sync_gap_ms=337"
+    assert problem["pairs_accepted"] == 4
+    assert "do not pair" in problem["message"]
+
+    # With the option the recording pairs, and inspect reports no problem.
+    result = runner.invoke(app, ["inspect", str(path), "--json", "--set", "io.max_sync_gap_ms=337"])
+    assert result.exit_code == 0, result.output
+    rec = json.loads(result.stdout)["recording"]
+    assert rec["num_frames"] == 4 and rec["sync"]["problems"] == []

@@ -228,3 +228,55 @@ def test_a_depth_image_unlike_the_colour_camera_keeps_needing_its_camera_info(
     ):
         with pytest.raises(TopicError, match="no CameraInfo for this image topic"):
             open_recording(path, streams=streams)
+
+
+def test_streams_that_pair_on_no_common_frame(tmp_path: Path) -> None:
+    # Depth pairs with the first two colour frames only, thermal with the last two only.
+    path = tmp_path / "apart.mcap"
+    with RecordingWriter(path, "mcap") as w:
+        for i in range(4):
+            s = T0 + i * 200_000_000
+            put(w, "/camera/rgb/image_color", s, rgb_image(i), RGB_CAM, "rgb8")
+            if i < 2:
+                put(w, "/camera/depth/image_raw", s + 1_000_000, depth_image(i), DEPTH_CAM, "16UC1")
+            else:
+                put(w, "/thermal/image_raw", s + 1_000_000, thermal_image(i), THERMAL_CAM, "mono16")
+    streams = (StreamSpec("colour"), StreamSpec("depth"), StreamSpec("thermal"))
+    with pytest.raises(SyncError, match="no frame has every stream within the sync gap"):
+        open_recording(path, streams=streams)
+    rec = open_recording(path, streams=streams, unpaired_ok=True)
+    assert len(rec) == 0
+    (problem,) = rec.info.sync.problems
+    assert problem.role is None and "no frame has every stream" in problem.message
+
+
+def test_no_pair_suggests_the_gap_that_pairs_the_most(tmp_path: Path) -> None:
+    # Colour runs for a second at 10 Hz; depth only for its last four tenths, 40 ms late.
+    # Every depth image pairs within 40 ms; the first colour image is 640 ms from any depth.
+    path = tmp_path / "late_depth.mcap"
+    ms = 1_000_000
+    with RecordingWriter(path, "mcap") as w:
+        for i in range(10):
+            put(w, "/camera/rgb/image_color", T0 + i * 100 * ms, rgb_image(i), RGB_CAM, "rgb8")
+            if i >= 6:
+                depth = depth_image(i)
+                put(
+                    w,
+                    "/camera/depth/image_raw",
+                    T0 + (i * 100 + 40) * ms,
+                    depth,
+                    DEPTH_CAM,
+                    "16UC1",
+                )
+    with pytest.raises(
+        SyncError,
+        match=r"within 40\.0 ms: accept them with --set io\.max_sync_gap_ms=41 \(pairs 4 of 10",
+    ):
+        open_recording(path)
+    (problem,) = open_recording(path, unpaired_ok=True).info.sync.problems
+    assert (problem.smallest_gap_ms, problem.needed_gap_ms, problem.pairs_accepted) == (
+        40.0,
+        40.0,
+        4,
+    )
+    assert len(open_recording(path, IoConfig(max_sync_gap_ms=41)).frame_stamps) == 4

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -12,11 +13,19 @@ from rgbd_eval.bench import BenchResult
 from rgbd_eval.cli.bench_cmd import STAGE_LABELS
 from rgbd_eval.cli.main import app
 from rgbd_eval.compare import compare_reports
-from rgbd_eval.config import Gating
+from rgbd_eval.config import Gating, load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.metrics import Counts
+from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.report_html import bench_page, compare_page, reproduce_page, write_sweep_html
+from rgbd_eval.report import file_digest, report_dict
+from rgbd_eval.report_html import (
+    bench_page,
+    compare_page,
+    reproduce_page,
+    write_run_html,
+    write_sweep_html,
+)
 from rgbd_eval.reproduce import Claim, Reproduction, to_json
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import SweepRecord, SweepResult
@@ -40,6 +49,16 @@ def run_dir(recording: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
     out = tmp_path_factory.mktemp("html_run") / "run"
     result = CliRunner().invoke(app, ["run", str(recording), "--out", str(out), "--video"])
     assert result.exit_code == 0, result.output
+    return out
+
+
+@pytest.fixture(scope="session")
+def unscored_dir(recording: Path, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The outputs of a run without ground truth: the short recording's, its ground truth dropped."""
+    config = load_config(method="basso2012")
+    result = replace(run_sequence(recording, config), ground_truth=None, scores=None)
+    out = tmp_path_factory.mktemp("html_unscored")
+    write_run_html(out, [result], config, report_dict([result], config, [file_digest(recording)]))
     return out
 
 
@@ -155,9 +174,13 @@ def bench_result() -> BenchResult:
 
 @pytest.fixture(scope="session")
 def pages(
-    run_dir: Path, score_dir: Path, tmp_path_factory: pytest.TempPathFactory
+    run_dir: Path,
+    unscored_dir: Path,
+    score_dir: Path,
+    tmp_path_factory: pytest.TempPathFactory,
 ) -> dict[str, Path]:
-    """Every page: the run's report.html, and sweep, compare, reproduce and bench pages."""
+    """Every page: the report.html of a run, of a run without ground truth and of ``score``,
+    and the sweep, compare, reproduce and bench pages."""
     out = tmp_path_factory.mktemp("html_pages")
     write_sweep_html(out, sweep_result(), "basso2012", ["short.mcap"], [], Gating.IOU)
     baseline = json.loads((run_dir / "report.json").read_text())
@@ -171,6 +194,7 @@ def pages(
     (out / "bench.html").write_text(bench_page(bench_result(), STAGE_LABELS))
     return {
         "run": run_dir / "report.html",
+        "unscored": unscored_dir / "report.html",
         "score": score_dir / "report.html",
         "sweep": out / "sweep.html",
         "compare": out / "compare.html",

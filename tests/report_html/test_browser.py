@@ -49,7 +49,9 @@ def _chromium(tmp: Path, *args: str) -> str:
     return done.stdout
 
 
-@pytest.mark.parametrize("page", ["run", "score", "sweep", "compare", "reproduce", "bench"])
+@pytest.mark.parametrize(
+    "page", ["run", "unscored", "score", "sweep", "compare", "reproduce", "bench"]
+)
 def test_page_renders_with_every_image_loaded(
     pages: dict[str, Path], page: str, tmp_path: Path
 ) -> None:

@@ -12,6 +12,7 @@ from rgbd_eval.report_html.events import (
     FrameErrors,
     Marker,
     MarkerKind,
+    busiest_frames,
     frame_errors,
     markers,
     worst_frames,
@@ -101,6 +102,17 @@ def test_worst_frames_are_spread_and_skip_clean_frames() -> None:
     assert worst_frames(_totals(*totals), 3) == [5, 7, 12]
     assert worst_frames(_totals(0, 0, 0), 2) == []
     assert worst_frames(_totals(1, 2), 0) == []
+
+
+def test_busiest_frames_take_the_most_tracks_of_each_stretch() -> None:
+    # 16 frames, 4 wanted: one from each stretch of 4, the most tracks, nearest its middle.
+    tracks = [0, 1, 1, 0, 2, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 1]
+    # 1 and 2 tie, as near the middle (1.5): the earlier; 8-11 have none: the scene is shown.
+    assert busiest_frames(tracks, 4) == [1, 4, 9, 13]
+    assert busiest_frames(tracks, 1) == [4]
+    assert busiest_frames([3, 0, 1], 4) == [0, 1, 2]
+    assert busiest_frames([1, 2], 0) == []
+    assert busiest_frames([], 4) == []
 
 
 def _box(slot: int) -> Box2D:

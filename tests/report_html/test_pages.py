@@ -93,7 +93,9 @@ def test_run_writes_html_plots_and_video_beside_the_report(run_dir: Path) -> Non
     assert 'href="short.overlay.mp4"' in html
 
 
-@pytest.mark.parametrize("page", ["run", "score", "sweep", "compare", "reproduce", "bench"])
+@pytest.mark.parametrize(
+    "page", ["run", "unscored", "score", "sweep", "compare", "reproduce", "bench"]
+)
 def test_page_is_self_contained_and_its_images_decode(pages: dict[str, Path], page: str) -> None:
     html = pages[page].read_text(encoding="utf-8")
     assert html.startswith("<!DOCTYPE html>")
@@ -123,6 +125,25 @@ def test_run_page_content(pages: dict[str, Path], run_dir: Path) -> None:
     shots = re.findall(r'<img src="data:image/jpeg;base64,[^"]*" alt="short frame (\d+)"', html)
     assert shots and len(shots) <= 6
     assert shots == sorted(shots, key=int)
+
+
+def test_run_page_without_ground_truth_shows_the_tracks_on_the_camera_image(
+    pages: dict[str, Path], unscored_dir: Path
+) -> None:
+    html = pages["unscored"].read_text()
+    assert "Nothing was scored (no ground truth)." in html
+    assert "Worst frames" not in html
+    # Four frames spread over the 24, each captioned with the tracks drawn on it.
+    shots = re.findall(
+        r'<img src="data:image/jpeg;base64,[^"]*" alt="short frame (\d+)">'
+        r"<figcaption>frame \1: (\d+) tracks?</figcaption>",
+        html,
+    )
+    frames = [int(f) for f, _ in shots]
+    assert len(frames) == 4 and frames == sorted(frames)
+    assert [f * 4 // FRAMES for f in frames] == [0, 1, 2, 3]  # one from each quarter
+    assert sum(int(n) for _, n in shots) > 0
+    assert (unscored_dir / "short.birdseye.png").stat().st_size > 0
 
 
 def test_compare_page_colours_rows_by_status(pages: dict[str, Path]) -> None:
@@ -159,6 +180,28 @@ def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) 
     assert "bird&#39;s-eye" not in html and "image/jpeg" not in html
     assert html.count("<img ") == 1  # the error timeline
     assert not (pages["score"].parent / "tracks.birdseye.png").exists()
+
+
+def test_score_page_tables(pages: dict[str, Path], score_dir: Path) -> None:
+    import json
+
+    html = pages["score"].read_text()
+    # Metrics: FP and FN with their counts; person 1 matched in 3 of 4 frames: partly tracked.
+    assert "<th>FP</th><th>FN</th>" in html and "<th>MT</th><th>PT</th><th>ML</th>" in html
+    assert "<td>25.0% (1)</td><td>25.0% (1)</td>" in html
+    assert "<td>0</td><td>1</td><td>0</td>" in html  # MT, PT, ML
+    # Inputs: each file on its own line with its own checksum.
+    seq = json.loads((score_dir / "report.json").read_text())["sequences"][0]
+    lines = {
+        m[0]: m[1]
+        for m in re.findall(
+            r'<td class="left mono">([0-9a-f]{64})</td><td class="left mono">([^<]*)</td>', html
+        )
+    }
+    assert lines == {
+        seq["tracks_sha256"]: seq["path"],
+        seq["sha256"]: seq["ground_truth"]["source"],
+    }
 
 
 def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidence() -> None:

@@ -5,11 +5,12 @@ from __future__ import annotations
 import functools
 import signal
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any, ParamSpec, TypeVar
 
 import typer
+from rich import box
 from rich.console import Console
 from rich.progress import (
     BarColumn,
@@ -19,6 +20,8 @@ from rich.progress import (
     TextColumn,
     TimeRemainingColumn,
 )
+from rich.table import Table
+from rich.text import Text
 
 from rgbd_eval.errors import ConfigError, RgbdEvalError
 
@@ -34,6 +37,23 @@ console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
 err_console = Console(stderr=True, highlight=False)
 
 SCHEMA_VERSION = 1
+
+
+def metrics_table(title: str, header: Sequence[str], rows: Sequence[Sequence[str]]) -> Table:
+    """The metrics table of ``run`` and ``score``, its cells plain text, the overall row bold.
+
+    Rules under the header only and one space of padding: its 16 columns fit the
+    140 columns of piped output on one line each.
+    """
+    table = Table(
+        title=Text(title), title_justify="left", box=box.SIMPLE_HEAD, padding=(0, 0, 0, 1)
+    )
+    for i, head in enumerate(header):
+        table.add_column(head, justify="left" if i == 0 else "right")
+    for row in rows:
+        table.add_row(*map(Text, row), style="bold" if row[0] == "overall" else None)
+    return table
+
 
 CLUSTER_HELP = (
     "where tasks run: local (one worker per usable CPU), local:N, or tcp://scheduler:8786"

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+from rich.markup import escape
 from rich.table import Table
 
 from rgbd_eval.cli.common import (
@@ -53,10 +54,15 @@ def inspect_data(
     gt_path: Path | None = None,
     streams: Sequence[StreamSpec] = ALL_STREAMS,
 ) -> dict[str, Any]:
-    """Everything ``inspect`` reports, as a JSON-ready dict."""
-    rec = open_recording(path, io, streams)
+    """Everything ``inspect`` reports, as a JSON-ready dict.
+
+    Streams that do not pair are findings (``recording.sync.problems``), not an error:
+    the rest of the recording is still described.
+    """
+    rec = open_recording(path, io, streams, unpaired_ok=True)
     info: RecordingInfo = rec.info
-    next(iter(rec.frames()))  # decode one frame: encodings and image sizes are checked here
+    if len(rec):
+        next(iter(rec.frames()))  # decode one frame: encodings and image sizes are checked here
     sidecar = gt_path or sidecar_for(path)
     data: dict[str, Any] = {"schema_version": SCHEMA_VERSION, "recording": jsonable(info)}
     gts = []
@@ -97,13 +103,23 @@ def _print_human(data: dict[str, Any]) -> None:
         f"sync: {s['frames']} frames on the {s['reference']} stamps, "
         f"{s['no_pose_dropped']} dropped without pose (largest gap accepted {s['max_gap_ms']:.1f} ms)"
     )
+    unpaired = {p["role"]: p for p in s["problems"] if p["role"]}
     for st in s["streams"]:
-        gap = (
-            ""
-            if st["role"] == s["reference"]
-            else (f", worst gap {st['worst_gap_ms']:.2f} ms, mean {st['mean_gap_ms']:.2f} ms")
-        )
+        if st["role"] == s["reference"]:
+            gap = ""
+        elif (p := unpaired.get(st["role"])) is not None and p["smallest_gap_ms"] is not None:
+            gap = f", none paired (smallest offset {p['smallest_gap_ms']:.1f} ms)"
+        elif st["role"] in unpaired:
+            gap = ", none paired"
+        else:
+            gap = f", worst gap {st['worst_gap_ms']:.2f} ms, mean {st['mean_gap_ms']:.2f} ms"
         console.print(f"  {st['role']}: {st['messages']} messages, {st['dropped']} dropped{gap}")
+    for p in s["problems"]:
+        console.print(f"[red]{escape(p['message'])}[/]", soft_wrap=True)
+    if s["problems"]:
+        console.print(
+            "run refuses this recording until the streams pair (no frame: images not decoded)"
+        )
     for role, c in info["cameras"].items():
         console.print(
             f"{role} camera: {c['width']}x{c['height']} fx={c['fx']:.1f} fy={c['fy']:.1f} "

@@ -7,6 +7,7 @@ from typing import Annotated, Any
 
 import typer
 from rich.table import Table
+from rich.text import Text
 
 from rgbd_eval.cli.common import SCHEMA_VERSION, console, handle_errors
 
@@ -46,6 +47,7 @@ def methods_data() -> list[dict[str, Any]]:
 
 
 def _streams(streams: list[dict[str, Any]]) -> str:
+    """``colour, [depth]``: the roles read, ``[optional]``, ``depth...`` for one or more."""
     parts = []
     for s in streams:
         text = s["role"] + ("..." if s["multiple"] else "")
@@ -57,16 +59,17 @@ def _streams(streams: list[dict[str, Any]]) -> str:
 def methods(
     json_out: Annotated[bool, typer.Option("--json", help="machine-readable JSON")] = False,
 ) -> None:
-    """List the methods: streams read ([optional], ... = one or more), paper, default gating."""
+    r"""List the methods: streams read (\[optional], ... = one or more), paper, default gating."""
     data = methods_data()
     if json_out:
         typer.echo(json.dumps({"schema_version": SCHEMA_VERSION, "methods": data}, indent=2))
         return
     table = Table(title="methods", title_justify="left")
     for col in ("method", "streams", "detector + tracker", "gating", "reproduce", "paper"):
-        table.add_column(col, overflow="fold")
+        # method and streams stay on one line; the cells are plain text, not rich markup
+        table.add_column(col, overflow="fold", no_wrap=col in ("method", "streams"))
     for m in data:
-        table.add_row(
+        cells = (
             m["method"],
             _streams(m["streams"]),
             f"{m['detector']} + {m['tracker']}"
@@ -75,4 +78,5 @@ def methods(
             "yes" if m["reproduce"] else "-",
             f"seed {m['seed']}: {m['title']}" if m["seed"] else m["title"],
         )
+        table.add_row(*map(Text, cells))
     console.print(table)

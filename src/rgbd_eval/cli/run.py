@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
@@ -19,6 +18,7 @@ from rgbd_eval.cli.common import (
     console,
     err_console,
     handle_errors,
+    metrics_table,
     progress_bar,
     topic_overrides,
     with_threshold,
@@ -81,16 +81,12 @@ def print_table(results: list[SequenceResult], config: RunConfig) -> None:
 
     scored = [r for r in results if r.scores is not None]
     if scored:
-        table = Table(
-            title=f"{config.method}, gating {config.evaluation.gating.value} "
-            f"(threshold {config.evaluation.effective_threshold()})",
-            title_justify="left",
+        title = (
+            f"{config.method}, gating {config.evaluation.gating.value} "
+            f"(threshold {config.evaluation.effective_threshold()})"
         )
-        for i, head in enumerate(table_header()):
-            table.add_column(head, justify="left" if i == 0 else "right")
-        for row in table_rows(results, config.evaluation.gating):
-            table.add_row(*row, style="bold" if row[0] == "overall" else None)
-        console.print(table)
+        rows = table_rows(results, config.evaluation.gating)
+        console.print(metrics_table(title, table_header(), rows))
     for note in run_notes(results, warnings=False):
         console.print(note)
 

@@ -8,7 +8,6 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.table import Table
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
@@ -16,6 +15,7 @@ from rgbd_eval.cli.common import (
     SetOption,
     console,
     handle_errors,
+    metrics_table,
     with_threshold,
 )
 from rgbd_eval.config import load_config
@@ -114,16 +114,11 @@ def score(
     from rgbd_eval.report import table_header
 
     ev = config.evaluation
-    table = Table(
-        title=f"gating {ev.gating.value} (threshold {ev.effective_threshold()}), "
-        f"convention {ev.convention.value}",
-        title_justify="left",
+    title = (
+        f"gating {ev.gating.value} (threshold {ev.effective_threshold()}), "
+        f"convention {ev.convention.value}"
     )
-    for i, head in enumerate(table_header()):
-        table.add_column(head, justify="left" if i == 0 else "right")
-    for row in table_rows(sequences, ev.gating):
-        table.add_row(*row, style="bold" if row[0] == "overall" else None)
-    console.print(table)
+    console.print(metrics_table(title, table_header(), table_rows(sequences, ev.gating)))
     for s in sequences:
         for w in s.warnings:
             console.print(f"{s.name}: warning: {w}")

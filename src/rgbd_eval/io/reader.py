@@ -117,6 +117,26 @@ class StreamSync:
 
 
 @dataclass(frozen=True)
+class SyncProblem:
+    """A stream none of whose messages pairs with the reference stream within the sync gap.
+
+    ``smallest_gap_ms`` is the smallest offset between the two streams' stamps and
+    ``needed_gap_ms`` the smallest sync gap at which as many messages pair as can;
+    ``accept_with`` sets ``option`` to it, which pairs ``pairs_accepted`` reference
+    messages. Without a role: no frame has every stream.
+    """
+
+    message: str
+    role: str | None = None
+    topic: str | None = None
+    smallest_gap_ms: float | None = None
+    needed_gap_ms: float | None = None
+    option: str = "io.max_sync_gap_ms"
+    accept_with: str | None = None
+    pairs_accepted: int | None = None
+
+
+@dataclass(frozen=True)
 class SyncStats:
     """How the streams pair up: per stream, against the reference (the first stream)."""
 
@@ -125,6 +145,8 @@ class SyncStats:
     frames: int
     no_pose_dropped: int
     max_gap_ms: float
+    #: Why nothing pairs (only with ``open_recording(..., unpaired_ok=True)``).
+    problems: tuple[SyncProblem, ...] = ()
 
     @property
     def worst_gap_ms(self) -> float:
@@ -600,12 +622,16 @@ def open_recording(
     path: Path | str,
     io: IoConfig | None = None,
     streams: Sequence[StreamSpec] = RGBD_STREAMS,
+    *,
+    unpaired_ok: bool = False,
 ) -> Recording:
     """Index a recording for ``streams`` (see the module docstring).
 
     The first stream present is the reference: frames carry its stamps, and every
     other stream is paired to it by nearest header stamp within ``io.max_sync_gap_ms``.
-    Raises :class:`InputError` subclasses.
+    Raises :class:`InputError` subclasses. A stream that does not pair at all is a
+    :class:`SyncError`, or with ``unpaired_ok`` a recording of no frames whose
+    ``info.sync.problems`` say why (what ``inspect`` shows).
     """
     path = Path(path)
     io = io or IoConfig()
@@ -742,17 +768,14 @@ def open_recording(
     max_gap_ns = int(io.max_sync_gap_ms * 1e6)
     partner: dict[str, dict[int, int]] = {}
     stream_sync = []
+    problems: list[SyncProblem] = []
     for role in list(chosen)[1:]:
         pairing: Pairing = pair_nearest(stamps[reference], stamps[role], max_gap_ns)
         if not pairing.pairs:
-            smallest = _smallest_gap_ms(stamps[reference], stamps[role])
-            raise SyncError(
-                path,
-                f"no {reference}/{role} pair within {io.max_sync_gap_ms} ms "
-                f"({chosen[reference]}: {stamps[reference].size} messages, {chosen[role]}: "
-                f"{stamps[role].size}); the smallest offset is {smallest:.1f} ms: accept it "
-                f"with --set io.max_sync_gap_ms={math.ceil(smallest + 1)}",
-            )
+            problem = _unpaired(io, reference, role, chosen, stamps)
+            if not unpaired_ok:
+                raise SyncError(path, problem.message)
+            problems.append(problem)
         partner[role] = dict(pairing.pairs)
         stream_sync.append(
             StreamSync(
@@ -808,11 +831,14 @@ def open_recording(
                 poses,
             )
         )
-    if not plan and skipped:
+    if not plan and partner and not problems and all(partner.values()) and not no_pose:
+        problem = SyncProblem("no frame has every stream within the sync gap")
+        if not unpaired_ok:
+            raise SyncError(path, problem.message)
+        problems.append(problem)
+    if not plan and skipped and not problems:
         raise DecodeError(path, f"no usable frame left: {skip_note}")
-    if not plan:
-        if partner and not any(partner.values()):
-            raise SyncError(path, "no frame has every stream within the sync gap")
+    if not plan and not problems:
         raise TransformError(path, f"no frame has a pose from {world_frame!r} to {camera_frame!r}")
     if no_pose:
         warnings.append(
@@ -842,6 +868,7 @@ def open_recording(
         frames=len(plan),
         no_pose_dropped=no_pose,
         max_gap_ms=io.max_sync_gap_ms,
+        problems=tuple(problems),
     )
     dropped = [f"{s.dropped} {s.role}" for s in sync.streams if s.dropped]
     if dropped:
@@ -893,15 +920,61 @@ def _skip_wrong_sizes(
         index.sizes[topic] = [sizes[k] for k in keep]
 
 
-def _smallest_gap_ms(a: NDArray[np.int64], b: NDArray[np.int64]) -> float:
-    """The smallest |a_i - b_j| in milliseconds (both sorted, non-empty)."""
-    if a.size == 0 or b.size == 0:
-        return float("inf")
-    j = np.clip(np.searchsorted(b, a), 1, b.size - 1) if b.size > 1 else np.zeros(a.size, int)
-    gaps = np.abs(a - b[j])
-    if b.size > 1:
-        gaps = np.minimum(gaps, np.abs(a - b[j - 1]))
-    return float(gaps.min()) / 1e6
+def _neighbour_gaps_ns(a: NDArray[np.int64], b: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The offsets of each a_i to its neighbours in b on either side (both sorted, non-empty)."""
+    j = np.searchsorted(b, a)
+    before, after = j > 0, j < b.size
+    return np.concatenate([a[before] - b[j[before] - 1], b[j[after]] - a[after]]).astype(np.int64)
+
+
+def _unpaired(
+    io: IoConfig,
+    reference: str,
+    role: str,
+    chosen: Mapping[str, str],
+    stamps: Mapping[str, NDArray[np.int64]],
+) -> SyncProblem:
+    """Why ``role`` pairs with no ``reference`` message, and the sync gap that would pair them.
+
+    That gap is the smallest at which as many messages pair as at any gap: the
+    candidates :func:`pair_nearest` weighs are every stamp's neighbours in the other
+    stream, and the pairs it keeps only grow with the gap, so a bisection over those
+    neighbours' offsets finds it.
+    """
+    ref, other = stamps[reference], stamps[role]
+    counts = f"({chosen[reference]}: {ref.size} messages, {chosen[role]}: {other.size})"
+    head = f"{reference} and {role} do not pair: no pair within {io.max_sync_gap_ms} ms {counts}"
+    if ref.size == 0 or other.size == 0:
+        return SyncProblem(f"{head}; a stream has no message", role, chosen[role])
+    gaps = np.unique(
+        np.concatenate([_neighbour_gaps_ns(ref, other), _neighbour_gaps_ns(other, ref)])
+    )
+
+    def pairs_within(gap_ns: int) -> int:
+        return len(pair_nearest(ref, other, gap_ns).pairs)
+
+    most = pairs_within(int(gaps[-1]))
+    lo, hi = 0, gaps.size - 1  # the first gap at which ``most`` pair is in gaps[lo:hi + 1]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if pairs_within(int(gaps[mid])) == most:
+            hi = mid
+        else:
+            lo = mid + 1
+    smallest, needed = float(gaps[0]) / 1e6, float(gaps[lo]) / 1e6
+    accept = math.ceil(needed + 1)
+    setting = f"--set {SyncProblem.option}={accept}"
+    return SyncProblem(
+        f"{head}; the smallest offset is {smallest:.1f} ms, and as many as can pair do within "
+        f"{needed:.1f} ms: accept them with {setting} (pairs {most} of {ref.size} "
+        f"{reference} messages)",
+        role,
+        chosen[role],
+        smallest,
+        needed,
+        accept_with=setting,
+        pairs_accepted=most,
+    )
 
 
 def _rate(stamps: list[int] | None) -> float | None:

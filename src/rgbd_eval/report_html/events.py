@@ -15,6 +15,7 @@ convention (see :mod:`rgbd_eval.metrics.clear`):
 from __future__ import annotations
 
 import enum
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -126,3 +127,21 @@ def worst_frames(errors: Sequence[FrameErrors], count: int) -> list[int]:
         if all(abs(e.frame - c) > separation for c in chosen):
             chosen.append(e.frame)
     return sorted(chosen)
+
+
+def busiest_frames(tracks: Sequence[int], count: int) -> list[int]:
+    """Up to ``count`` frames spread over the sequence, each with the most tracks of its stretch.
+
+    ``tracks`` is the number of tracks of every frame. The sequence is cut into ``count``
+    equal stretches; of each, the frame with the most tracks is taken (on ties the one
+    nearest the stretch's middle, then the earlier), so a frame without tracks is taken
+    only from a stretch that has none, to show the scene.
+    """
+    n = len(tracks)
+    bounds = [round(k * n / count) for k in range(count + 1)] if count > 0 else []
+    chosen = []
+    for start, stop in itertools.pairwise(bounds):
+        if start < stop:
+            middle = (start + stop - 1) / 2
+            chosen.append(min(range(start, stop), key=lambda i: (-tracks[i], abs(i - middle), i)))
+    return chosen

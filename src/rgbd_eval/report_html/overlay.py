@@ -98,6 +98,11 @@ def _label(
     cv2.putText(image, text, (x + 2, top + h + 2), font, scale, ink, weight, cv2.LINE_AA)
 
 
+def drawn_tracks(tracks: Sequence[TrackOutput]) -> list[TrackOutput]:
+    """The tracks :func:`draw_frame` draws: those scored, with a box on the image."""
+    return [t for t in tracks if t.box2d is not None and is_scored_track(t)]
+
+
 def draw_frame(
     rgb: NDArray[np.uint8],
     tracks: Sequence[TrackOutput],
@@ -118,9 +123,8 @@ def draw_frame(
         bottom = round(o.box2d.top + o.box2d.height)
         tag = "miss" if o.object_id in missed else ("ign" if o.ignore else "gt")
         _label(image, f"{tag} {o.object_id}", x, bottom, colour, below=True)
-    for t in tracks:
-        if t.box2d is None or not is_scored_track(t):
-            continue
+    for t in drawn_tracks(tracks):
+        assert t.box2d is not None  # drawn_tracks keeps only tracks with a box
         colour = track_colour(t.track_id)
         occluded = t.visibility is Visibility.OCCLUDED
         x, y = _box(image, t.box2d, colour, 1 if occluded else 3)

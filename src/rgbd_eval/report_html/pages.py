@@ -23,8 +23,8 @@ from rgbd_eval.metrics import SequenceScores, Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
 from rgbd_eval.report import COLUMNS, format_value, run_notes, table_header, table_rows
 from rgbd_eval.report_html import plots
-from rgbd_eval.report_html.events import frame_errors, markers, worst_frames
-from rgbd_eval.report_html.overlay import rgb_frames
+from rgbd_eval.report_html.events import busiest_frames, frame_errors, markers, worst_frames
+from rgbd_eval.report_html.overlay import drawn_tracks, rgb_frames
 from rgbd_eval.report_html.render import data_uri, jpeg_uri, render
 from rgbd_eval.report_html.video import Progress, overlay, write_overlay_video
 from rgbd_eval.types import GroundTruthObject, TrackOutput
@@ -38,6 +38,8 @@ if TYPE_CHECKING:
 
 #: Frames in the worst-frame strip of each sequence.
 WORST_FRAMES = 6
+#: Frames shown of a sequence without ground truth (no worst frames): the tracks on the image.
+TRACK_FRAMES = 4
 #: Columns of the short metric tables (sweep, reproduce): those of the thesis' Tables 7.2-7.6.
 SHORT_COLUMNS = COLUMNS[:7]
 
@@ -47,7 +49,7 @@ SHORT_COLUMNS = COLUMNS[:7]
 
 @dataclass(frozen=True)
 class Shot:
-    """One frame of the worst-frame strip."""
+    """One frame of the strip: the worst frames, or without ground truth the tracks' frames."""
 
     frame: int
     uri: str
@@ -80,7 +82,7 @@ class SequenceSection:
     shots: tuple[Shot, ...]
     error_frames: int
     video: str | None
-    #: Worst frames that could not be shown: the recording was read without colour.
+    #: Frames of the strip that could not be shown: the recording was read without colour.
     no_colour: int = 0
 
 
@@ -97,15 +99,27 @@ def config_diff(config: RunConfig) -> list[tuple[str, Any, Any]]:
     ]
 
 
+def strip_frames(
+    tracks: Sequence[Sequence[TrackOutput]], scores: SequenceScores | None
+) -> list[int]:
+    """The frames a sequence's strip shows: the worst, or without scores the busiest."""
+    if scores is not None:
+        return worst_frames(frame_errors(scores.frames), WORST_FRAMES)
+    return busiest_frames([len(drawn_tracks(t)) for t in tracks], TRACK_FRAMES)
+
+
 def _section(
     folder: Path,
     view: SequenceView,
     images: Mapping[int, NDArray[np.uint8]],
-    worst: Sequence[int],
+    shown: Sequence[int],
     video: str | None,
     birds_eye: bool = True,
 ) -> SequenceSection:
-    """The section of one sequence; with ``birds_eye`` also writes ``<name>.birdseye.png``."""
+    """The section of one sequence; with ``birds_eye`` also writes ``<name>.birdseye.png``.
+
+    ``shown`` are the frames of the strip (:func:`strip_frames`), ``images`` those drawn.
+    """
     scores = view.scores
     marks = markers(scores.frames, scores.counts.convention) if scores is not None else []
     uri = None
@@ -113,23 +127,26 @@ def _section(
         png = plots.birds_eye(view.name, view.world_frame, view.ground_truth, view.tracks, marks)
         (folder / f"{view.name}.birdseye.png").write_bytes(png)
         uri = data_uri(png)
-    if view.scores is None:
-        return SequenceSection(view.name, uri, None, (), 0, video)
-    errors = frame_errors(view.scores.frames)
     shots = []
-    for i in worst:
-        if i in images:
+    errors = frame_errors(scores.frames) if scores is not None else []
+    for i in shown:
+        if i not in images:
+            continue
+        if scores is not None:
             e = errors[i]
             caption = f"frame {i}: {e.fp} FP, {e.fn} FN, {e.id_switches} ID switch(es)"
-            shots.append(Shot(i, jpeg_uri(images[i]), caption))
+        else:
+            n = len(drawn_tracks(view.tracks[i]))
+            caption = f"frame {i}: {n} track{'' if n == 1 else 's'}"
+        shots.append(Shot(i, jpeg_uri(images[i]), caption))
     return SequenceSection(
         view.name,
         uri,
-        data_uri(plots.timeline(errors, worst)),
+        data_uri(plots.timeline(errors, shown)) if scores is not None else None,
         tuple(shots),
         sum(e.total > 0 for e in errors),
         video,
-        no_colour=len(worst) - len(shots),
+        no_colour=len(shown) - len(shots),
     )
 
 
@@ -170,23 +187,23 @@ def write_run_html(
     ``<name>.overlay.mp4`` per sequence into ``folder`` (a run's staged output folder).
 
     The recordings are read again for the RGB images: with ``video`` every frame,
-    else only up to the last of the worst frames.
+    else only up to the last frame of the strip (:func:`strip_frames`).
     """
     sections = []
     for r in results:
-        worst = worst_frames(frame_errors(r.scores.frames), WORST_FRAMES) if r.scores else []
+        shown = strip_frames(r.tracks, r.scores)
         video_name = None
         if video:
             video_name = f"{r.name}.overlay.mp4"
-            made = write_overlay_video(folder / video_name, r, config, worst, progress)
+            made = write_overlay_video(folder / video_name, r, config, shown, progress)
             images = made.kept
         else:
             images = {
                 i: overlay(r, i, rgb)
-                for i, rgb in rgb_frames(Path(r.path), config, worst)
+                for i, rgb in rgb_frames(Path(r.path), config, shown)
                 if rgb is not None
             }
-        sections.append(_section(folder, SequenceView.of_run(r), images, worst, video_name))
+        sections.append(_section(folder, SequenceView.of_run(r), images, shown, video_name))
     write_text(folder / "report.html", run_page(results, config, report, sections))
 
 

@@ -30,6 +30,7 @@ def birds_eye(
 ) -> bytes:
     """PNG of ground-truth paths (grey, dashed) under track paths (colour of their id), events marked.
 
+    Every position is a dot on its path, so a person standing still shows as one.
     Only scored tracks are drawn (validated, not ``NOT_VISIBLE``). Id switches are
     red crosses, fragmentations orange triangles, placed at the object's
     ground-truth position in that frame.
@@ -49,7 +50,16 @@ def birds_eye(
                     where[index, o.object_id] = xy
         for k, (oid, pts) in enumerate(sorted(paths.items())):
             xs, ys = zip(*pts, strict=True)
-            ax.plot(xs, ys, "--", color="0.55", lw=2.0, label="ground truth" if k == 0 else None)
+            ax.plot(
+                xs,
+                ys,
+                "--",
+                color="0.55",
+                lw=2.0,
+                marker="o",
+                ms=3,
+                label="ground truth" if k == 0 else None,
+            )
             ax.annotate(f"gt {oid}", pts[0], color="0.35", fontsize=8)
     track_paths: dict[int, list[tuple[float, float]]] = {}
     for frame_tracks in tracks:
@@ -58,7 +68,16 @@ def birds_eye(
                 track_paths.setdefault(t.track_id, []).append((t.x, t.y))
     for tid, pts in sorted(track_paths.items()):
         xs, ys = zip(*pts, strict=True)
-        ax.plot(xs, ys, "-", color=_rgb(track_colour(tid)), lw=1.3, label=f"track {tid}")
+        ax.plot(
+            xs,
+            ys,
+            "-",
+            color=_rgb(track_colour(tid)),
+            lw=1.3,
+            marker="o",
+            ms=2.5,
+            label=f"track {tid}",
+        )
     styles = {
         MarkerKind.ID_SWITCH: ("X", "red", 90),
         MarkerKind.FRAGMENTATION: ("^", "darkorange", 60),
