@@ -15,12 +15,13 @@ Conventions (used everywhere in the package):
 from __future__ import annotations
 
 import enum
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 FloatArray = NDArray[np.float64]
 
@@ -154,9 +155,187 @@ class Pose:
 OPTICAL_TO_BODY = Pose((0.0, 0.0, 0.0), (-0.5, 0.5, -0.5, 0.5))
 
 
+# ----------------------------------------------------------------------------- lens distortion
+
+#: The ``CameraInfo.distortion_model`` values that :class:`CameraModel` applies, and how many
+#: coefficients of ``D`` each takes (ROS ``sensor_msgs/distortion_models.h``, OpenCV's
+#: order). ``plumb_bob`` (k1 k2 p1 p2 k3) and ``rational_polynomial`` (then k4 k5 k6, the
+#: denominator) are OpenCV's ``projectPoints`` model; ``equidistant`` (k1 k2 k3 k4) is
+#: OpenCV's ``fisheye`` model.
+DISTORTION_MODELS: Mapping[str, int] = {"plumb_bob": 8, "rational_polynomial": 8, "equidistant": 4}
+
+#: The polynomial model is searched for a fold up to this undistorted radius (84 deg off axis).
+_FOLD_SEARCH_RADIUS = 10.0
+_FOLD_SEARCH_STEPS = 20_000
+#: Newton iterations of :meth:`Lens.undistort` at most; it stops at this relative step (the
+#: error after it is far smaller: convergence is quadratic).
+_NEWTON_STEPS = 50
+_NEWTON_TOLERANCE = 1e-12
+
+
+@dataclass(frozen=True)
+class Lens:
+    """Lens distortion in normalised image coordinates (``x = X / Z``, ``y = Y / Z``).
+
+    ``coefficients``: k1 k2 p1 p2 k3 k4 k5 k6 of the polynomial model, or k1 k2 k3 k4 of the
+    ``fisheye`` (equidistant) model, as OpenCV defines them. A model folds back where its
+    distorted radius stops growing (two rays would meet at one pixel); beyond the first
+    fold (searched once per lens) the radial factor is held at its value there, so points
+    far outside the view project outside the image and every pixel has exactly one ray.
+    """
+
+    fisheye: bool
+    coefficients: tuple[float, ...]
+
+    def _factor(self, s2: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The radial factor ``f`` at the squared radius ``s2`` (polynomial: ``r^2``; fisheye:
+        ``theta^2``), and its derivative ``df / ds2``."""
+        if self.fisheye:
+            k1, k2, k3, k4 = self.coefficients
+            f = 1.0 + s2 * (k1 + s2 * (k2 + s2 * (k3 + s2 * k4)))
+            df = k1 + s2 * (2.0 * k2 + s2 * (3.0 * k3 + s2 * 4.0 * k4))
+            return f, df
+        k1, k2, _, _, k3, k4, k5, k6 = self.coefficients
+        num = 1.0 + s2 * (k1 + s2 * (k2 + s2 * k3))
+        den = 1.0 + s2 * (k4 + s2 * (k5 + s2 * k6))
+        dnum = k1 + s2 * (2.0 * k2 + s2 * 3.0 * k3)
+        dden = k4 + s2 * (2.0 * k5 + s2 * 3.0 * k6)
+        return num / den, (dnum * den - num * dden) / (den * den)
+
+    def _held(self, s2: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """:meth:`_factor`, held at its value beyond the fold (derivative 0 there)."""
+        s2_fold, f_fold = _fold(self)
+        f, df = self._factor(s2)
+        inside = s2 <= s2_fold
+        return np.where(inside, f, f_fold), np.where(inside, df, 0.0)
+
+    def distort(self, x: FloatArray, y: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Undistorted -> distorted normalised coordinates (OpenCV's forward model)."""
+        r2 = x * x + y * y
+        if self.fisheye:
+            r = np.sqrt(r2)
+            theta = np.arctan(r)
+            f = self._held(theta * theta)[0]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                scale = np.where(r > 1e-8, theta * f / r, 1.0)
+            return x * scale, y * scale
+        f = self._held(r2)[0]
+        return self._tangential(x, y, r2, f)
+
+    def _tangential(
+        self, x: FloatArray, y: FloatArray, r2: FloatArray, f: FloatArray
+    ) -> tuple[FloatArray, FloatArray]:
+        """The polynomial model: radial factor ``f`` and the tangential terms (p1, p2)."""
+        p1, p2 = self.coefficients[2:4]
+        xy2 = 2.0 * x * y
+        return (
+            x * f + p1 * xy2 + p2 * (r2 + 2.0 * x * x),
+            y * f + p1 * (r2 + 2.0 * y * y) + p2 * xy2,
+        )
+
+    def undistort(self, xd: FloatArray, yd: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """Distorted -> undistorted normalised coordinates: :meth:`distort` inverted (NaN for a
+        fisheye point 90 deg or more off the axis).
+
+        The radius first (Newton's method kept between 0 and the fold, where the distorted
+        radius grows monotonically), then, for the polynomial model, Newton's method in 2D
+        for the tangential terms, from there.
+        """
+        xd = np.asarray(xd, dtype=np.float64)
+        yd = np.asarray(yd, dtype=np.float64)
+        d = np.sqrt(xd * xd + yd * yd)  # distorted radius (fisheye: the angle theta_d)
+        s = self._radius(d)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # A fisheye pixel 90 deg or more off the axis has no ray with z > 0: NaN.
+            r = np.where(s < np.pi / 2, np.tan(s), np.nan) if self.fisheye else s
+            scale = np.where(d > 1e-8, r / d, 1.0)
+        x, y = xd * scale, yd * scale
+        if self.fisheye or not any(self.coefficients[2:4]):
+            return x, y
+        for _ in range(_NEWTON_STEPS):
+            r2 = x * x + y * y
+            f, df = self._held(r2)
+            ex, ey = self._tangential(x, y, r2, f)
+            ex, ey = xd - ex, yd - ey
+            # The Jacobian of the model (symmetric), and one Newton step.
+            p1, p2 = self.coefficients[2:4]
+            j11 = f + 2.0 * x * x * df + 2.0 * p1 * y + 6.0 * p2 * x
+            j12 = 2.0 * x * y * df + 2.0 * p1 * x + 2.0 * p2 * y
+            j22 = f + 2.0 * y * y * df + 6.0 * p1 * y + 2.0 * p2 * x
+            with np.errstate(divide="ignore", invalid="ignore"):
+                det = j11 * j22 - j12 * j12
+                dx = (j22 * ex - j12 * ey) / det
+                dy = (j11 * ey - j12 * ex) / det
+            x, y = x + dx, y + dy
+            if _largest(dx / (1.0 + np.abs(x)), dy / (1.0 + np.abs(y))) <= _NEWTON_TOLERANCE:
+                break
+        return x, y
+
+    def _radius(self, d: FloatArray) -> FloatArray:
+        """The radius (fisheye: angle) ``s`` whose distorted radius ``s f(s^2)`` is ``d``:
+        Newton's method inside a bracket ``[0, fold]`` it narrows, bisecting when a step
+        would leave it."""
+        s2_fold, f_fold = _fold(self)
+        s_fold = float(np.sqrt(s2_fold))
+        beyond = d > s_fold * f_fold  # held factor: solved below, not iterated
+        lo, hi = np.where(beyond, s_fold, 0.0), np.full_like(d, s_fold)
+        s = np.minimum(d, s_fold)
+        for _ in range(_NEWTON_STEPS):
+            f, df = self._factor(s * s)
+            g = s * f - d
+            lo, hi = np.where(g < 0, s, lo), np.where(g < 0, hi, s)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                newton = s - g / (f + 2.0 * s * s * df)
+            inside = (newton >= lo) & (newton <= hi)
+            step = np.where(inside, newton, 0.5 * (lo + hi)) - s
+            s = s + step
+            if _largest(step / (1.0 + s)) <= _NEWTON_TOLERANCE:
+                break
+        out: FloatArray = np.where(beyond, d / f_fold, s)
+        return out
+
+
+def _largest(*arrays: FloatArray) -> float:
+    """The largest finite absolute value in ``arrays`` (0 when there is none)."""
+    return max(float(np.max(np.abs(a), initial=0.0, where=np.isfinite(a))) for a in arrays)
+
+
+@functools.lru_cache(maxsize=64)
+def _fold(lens: Lens) -> tuple[float, float]:
+    """``(s^2, f)`` at the lens' first fold: the squared radius (fisheye: angle) where the
+    distorted radius ``s f(s^2)`` stops growing, and the radial factor there."""
+    if lens.fisheye:  # theta below 90 deg, where tan is finite
+        s = np.linspace(0.0, np.pi / 2, _FOLD_SEARCH_STEPS + 1, endpoint=False)[1:]
+    else:
+        s = np.linspace(0.0, _FOLD_SEARCH_RADIUS, _FOLD_SEARCH_STEPS + 1)[1:]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        f = lens._factor(s * s)[0]
+        d = s * f
+        growing = np.isfinite(d[1:]) & (f[1:] > 0) & (d[1:] > d[:-1])
+    stops = np.flatnonzero(~growing)
+    i = int(stops[0]) if stops.size else s.size - 1
+    return float(s[i] * s[i]), float(f[i])
+
+
+@functools.lru_cache(maxsize=64)
+def _lens(model: str, coefficients: tuple[float, ...]) -> Lens | None:
+    """The lens a CameraInfo's model and ``D`` describe; None for none or an unknown model."""
+    n = DISTORTION_MODELS.get(model)
+    if n is None or not any(coefficients[:n]):
+        return None
+    k = tuple(float(c) for c in coefficients[:n]) + (0.0,) * (n - len(coefficients))
+    return Lens(model == "equidistant", k)
+
+
 @dataclass(frozen=True)
 class CameraModel:
-    """A pinhole camera (plumb-bob distortion kept for reference, images assumed rectified)."""
+    """A camera: pinhole intrinsics and the lens distortion of its ``CameraInfo``.
+
+    :meth:`project`, :meth:`rays`, :meth:`rays_at`, :meth:`points_at` and :meth:`backproject`
+    apply the distortion (:data:`DISTORTION_MODELS`); with all coefficients zero, or a
+    model not supported (:meth:`distortion_problem` says which), they are plain pinhole
+    arithmetic.
+    """
 
     width: int
     height: int
@@ -164,11 +343,15 @@ class CameraModel:
     fy: float
     cx: float
     cy: float
+    #: ``CameraInfo.D``: k1 k2 p1 p2 k3 [k4 k5 k6] (plumb_bob, rational_polynomial) or
+    #: k1 k2 k3 k4 (equidistant).
     distortion: tuple[float, ...] = ()
     frame_id: str = ""
     #: ``P[0, 3]`` of CameraInfo: ``-fx * baseline`` for the right camera of a rectified
     #: stereo pair (ROS convention), 0 for any other camera.
     tx: float = 0.0
+    #: ``CameraInfo.distortion_model``.
+    distortion_model: str = "plumb_bob"
 
     def __post_init__(self) -> None:
         if self.width <= 0 or self.height <= 0:
@@ -179,6 +362,29 @@ class CameraModel:
     @property
     def K(self) -> FloatArray:  # noqa: N802 - the textbook name of the intrinsic matrix
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    @property
+    def lens(self) -> Lens | None:
+        """The distortion applied; None for a pinhole (no non-zero coefficient of a supported
+        model)."""
+        return _lens(self.distortion_model, self.distortion)
+
+    def distortion_problem(self) -> str | None:
+        """What of the distortion is ignored (an unsupported model, extra coefficients)."""
+        n = DISTORTION_MODELS.get(self.distortion_model)
+        ignored = self.distortion if n is None else self.distortion[n:]
+        if not any(ignored):
+            return None
+        values = ", ".join(f"{v:g}" for v in ignored)
+        if n is None:
+            return (
+                f"distortion model {self.distortion_model!r} is not supported (only "
+                f"{', '.join(DISTORTION_MODELS)}): its coefficients ({values}) are ignored"
+            )
+        return (
+            f"{self.distortion_model} distortion takes {n} coefficients: "
+            f"the further ones ({values}) are ignored"
+        )
 
     def scaled(self, width: int, height: int) -> CameraModel:
         """The same camera at another resolution (decimation or up-sampling)."""
@@ -193,23 +399,48 @@ class CameraModel:
             self.distortion,
             self.frame_id,
             self.tx * sx,
+            self.distortion_model,
         )
 
     def project(self, points: FloatArray) -> FloatArray:
         """Project ``(N, 3)`` optical-frame points to ``(N, 2)`` pixel coordinates (u, v)."""
         p = np.asarray(points, dtype=np.float64)
         z = p[:, 2]
+        lens = self.lens
         with np.errstate(divide="ignore", invalid="ignore"):
-            u = self.fx * p[:, 0] / z + self.cx
-            v = self.fy * p[:, 1] / z + self.cy
+            if lens is None:
+                u = self.fx * p[:, 0] / z + self.cx
+                v = self.fy * p[:, 1] / z + self.cy
+            else:
+                x, y = lens.distort(p[:, 0] / z, p[:, 1] / z)
+                u = self.fx * x + self.cx
+                v = self.fy * y + self.cy
         return np.stack([u, v], axis=1)
 
+    def rays_at(self, u: ArrayLike, v: ArrayLike) -> FloatArray:
+        """Unit-depth rays (z = 1) through pixels ``(u, v)``, shape ``u.shape + (3,)``."""
+        x = (np.asarray(u, dtype=np.float64) - self.cx) / self.fx
+        y = (np.asarray(v, dtype=np.float64) - self.cy) / self.fy
+        lens = self.lens
+        if lens is None:
+            return np.stack([x, y, np.ones_like(x)], axis=-1)
+        x, y = lens.undistort(x, y)
+        return np.stack([x, y, np.where(np.isnan(x), np.nan, 1.0)], axis=-1)  # NaN: no ray
+
+    def points_at(self, u: ArrayLike, v: ArrayLike, z: ArrayLike) -> FloatArray:
+        """Optical-frame points at depth ``z`` (along the optical axis) seen at pixels ``(u, v)``."""
+        z = np.asarray(z, dtype=np.float64)
+        if self.lens is not None:
+            out: FloatArray = self.rays_at(u, v) * z[..., None]
+            return out
+        x = (np.asarray(u, dtype=np.float64) - self.cx) * z / self.fx
+        y = (np.asarray(v, dtype=np.float64) - self.cy) * z / self.fy
+        return np.stack(np.broadcast_arrays(x, y, z), axis=-1)
+
     def rays(self) -> FloatArray:
-        """Unit-depth rays ``(H, W, 3)`` through every pixel centre (z = 1)."""
-        u = (np.arange(self.width, dtype=np.float64) - self.cx) / self.fx
-        v = (np.arange(self.height, dtype=np.float64) - self.cy) / self.fy
-        uu, vv = np.meshgrid(u, v)
-        return np.stack([uu, vv, np.ones_like(uu)], axis=-1)
+        """Unit-depth rays ``(H, W, 3)`` through every pixel centre (z = 1; NaN where a fisheye
+        sees 90 deg or more off its axis); computed once per camera and shared (read-only)."""
+        return _ray_table(self)
 
     def backproject(self, depth: NDArray[np.floating]) -> FloatArray:
         """Depth image (metres, NaN invalid) -> ``(H, W, 3)`` optical-frame points (NaN invalid)."""
@@ -218,6 +449,23 @@ class CameraModel:
                 f"depth image is {depth.shape[1]}x{depth.shape[0]}, camera is {self.width}x{self.height}"
             )
         return self.rays() * depth[..., None].astype(np.float64)
+
+
+@functools.lru_cache(maxsize=8)
+def _ray_table(camera: CameraModel) -> FloatArray:
+    """:meth:`CameraModel.rays`, kept per camera (the table of a distorted lens is iterated)."""
+    if camera.lens is None:
+        u = (np.arange(camera.width, dtype=np.float64) - camera.cx) / camera.fx
+        v = (np.arange(camera.height, dtype=np.float64) - camera.cy) / camera.fy
+        uu, vv = np.meshgrid(u, v)
+        rays = np.stack([uu, vv, np.ones_like(uu)], axis=-1)
+    else:
+        uu, vv = np.meshgrid(
+            np.arange(camera.width, dtype=np.float64), np.arange(camera.height, dtype=np.float64)
+        )
+        rays = camera.rays_at(uu, vv)
+    rays.flags.writeable = False
+    return rays
 
 
 @dataclass(frozen=True)

@@ -71,6 +71,22 @@ def test_density_sums_points_in_one_cell_and_drops_points_outside_the_roi() -> N
     assert m.density.sum() == pytest.approx(0.080004, rel=1e-6)
 
 
+def test_density_bins_a_distorted_camera_along_its_undistorted_rays() -> None:
+    # Barrel distortion (k1 = -0.4) at fx = 40: pixel (50, 20) sees the ray (0.62, -0.31, 1)
+    # instead of the pinhole's (0.5, -0.25, 1); with the row and the column both off axis
+    # the rays are no longer a column term and a row term. At 1.5 m: floor y = -0.93 m.
+    cam = CameraModel(61, 61, 40.0, 40.0, 30.0, 30.0, (-0.4, 0.0, 0.0, 0.0, 0.0), "cam")
+    calib = CameraCalibration("cam", cam, LEVEL.floor_from_optical)
+    depth, fg = _image({(50, 20): 1.5})
+    m = camera_density(depth, fg, calib, GRID, min_height_m=1.0)
+    floor = calib.floor_from_optical.transform_points(cam.points_at(50, 20, 1.5)[None, :])[0]
+    col, row = np.floor(GRID.to_cell(floor[None, :2])[0]).astype(int)
+    assert m.cells.tolist() == [row * 40 + col]
+    pinhole = (50 - 30) / 40.0 * 1.5  # optical x, floor -y
+    assert floor[1] < -pinhole - 0.1  # more than a cell from the pinhole model's point
+    assert m.heights[0] == pytest.approx(floor[2])
+
+
 def test_density_does_not_depend_on_focal_length() -> None:
     # The same surface seen by a camera with twice the focal length (and 4x the pixels)
     # gives the same density: 4x the points, each with a quarter of the weight.

@@ -87,3 +87,37 @@ def test_projected_and_registered_paths_agree_without_extrinsics() -> None:
         a = np.sort(_box_depths_registered(view, box))
         b = np.sort(projected.depths(box))
         np.testing.assert_allclose(a, b, rtol=1e-6)
+
+
+#: A camera with barrel distortion (k1 = -0.3, k2 = 0.1): its corner pixels see 29 % farther out.
+LENS = CameraModel(64, 48, 40.0, 40.0, 31.5, 23.5, (-0.3, 0.1, 0.0, 0.0, 0.0))
+
+
+def test_a_distorted_camera_localises_along_its_undistorted_ray() -> None:
+    # A wall at z = 2 seen by the same lens in colour and (decimated) depth: the box still
+    # maps to a depth rectangle, and the position lies on the undistorted centre ray.
+    depth_cam = LENS.scaled(32, 24)
+    view = DepthView(np.full((24, 32), 2.0, np.float32), depth_cam, LENS, Pose(), Pose())
+    box = Box2D(2.0, 3.0, 10.0, 20.0)  # near the left edge
+    (lb,) = localise(view, [box]).boxes
+    assert lb.depth == pytest.approx(2.0)
+    x, y, _ = LENS.points_at(7.0, 13.0, 2.0)
+    np.testing.assert_allclose(lb.position, (x, y, 2.0))
+    pinhole = (7.0 - 31.5) / 40.0 * 2.0
+    assert x < pinhole - 0.2  # 21 cm farther out than the pinhole model says
+    top, bottom = LENS.rays_at([7.0, 7.0], [3.0, 23.0])
+    assert lb.height == pytest.approx((bottom[1] - top[1]) * 2.0)
+
+
+def test_different_lenses_take_the_projected_path() -> None:
+    # Registered (identity) but the colour lens is distorted and the depth one is not: a
+    # depth pixel no longer maps to the colour image affinely, so every point is projected.
+    rng = np.random.default_rng(5)
+    depth = rng.uniform(1.0, 5.0, (48, 64)).astype(np.float32)
+    pinhole = CameraModel(64, 48, 40.0, 40.0, 31.5, 23.5)
+    view = DepthView(depth, pinhole, LENS, Pose(), Pose())
+    box = Box2D(1.0, 1.0, 12.0, 30.0)
+    (lb,) = localise(view, [box]).boxes
+    projected = _ProjectedDepth(view).depths(box)
+    assert lb.depth == pytest.approx(np.percentile(projected, 25))
+    assert not np.array_equal(np.sort(projected), np.sort(_box_depths_registered(view, box)))

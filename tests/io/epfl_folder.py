@@ -1,9 +1,10 @@
 """Write small EPFL-RGBD sequence folders in the published layout (see rgbd_eval.io.epfl_rgbd).
 
-The scene: a Kinect v2 (the dataset's intrinsics) ``height_m`` above a flat floor, looking along
-the floor-frame x axis and pitched down by ``pitch_deg``; a far wall at x = 6 m; one "person",
-a flat board facing the camera (0.5 m wide, 1.8 m tall) standing at x = ``board_x``, centred on
-y = ``board_y`` (y to the left). Depth is the exact ray intersection, stored in millimetres.
+The scene: a Kinect v2 (the dataset's intrinsics and lens distortion) ``height_m`` above a flat
+floor, looking along the floor-frame x axis and pitched down by ``pitch_deg``; a far wall at
+x = 6 m; one "person", a flat board facing the camera (0.5 m wide, 1.8 m tall) standing at
+x = ``board_x``, centred on y = ``board_y`` (y to the left). Depth is the exact ray
+intersection, stored in millimetres.
 """
 
 from __future__ import annotations
@@ -38,10 +39,8 @@ def render_depth_m(
     """Optical depth (m) of floor, wall and board; NaN where a ray hits nothing."""
     cam = EPFL_KINECT2
     R = optical_to_floor(pitch_deg)
-    uu, vv = np.meshgrid(np.arange(cam.width, dtype=float), np.arange(cam.height, dtype=float))
-    rays = np.stack([(uu - cam.cx) / cam.fx, (vv - cam.cy) / cam.fy, np.ones_like(uu)], axis=-1)
-    d = rays @ R.T  # world direction per unit of optical depth
-    best = np.full(uu.shape, np.inf)
+    d = cam.rays() @ R.T  # world direction per unit of optical depth (lens distortion undone)
+    best = np.full(d.shape[:2], np.inf)
     with np.errstate(divide="ignore", invalid="ignore"):
         t_floor = np.where(d[..., 2] < 0, height_m / -d[..., 2], np.inf)
         best = np.minimum(best, t_floor)

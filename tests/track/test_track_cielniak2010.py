@@ -3,6 +3,8 @@ the warm-region proposals, the standing-height prior and the occlusion order the
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -40,6 +42,30 @@ def test_affine_of_parallel_cameras_hand_computed() -> None:
     )
     assert a.scale == pytest.approx((1.75, 1.75))
     assert a.offset == pytest.approx((50.875, 239.5 - 1.75 * 119.5))
+
+
+def test_affine_with_lens_distortion_is_fitted_to_the_exact_map() -> None:
+    # A barely distorted thermal camera gives the hand-computed map above; a distorted one
+    # the least-squares affine map of its pixels carried to the colour image at 3 m.
+    frame = _frame(0, np.zeros((240, 320)))
+    colour = frame.streams["colour"]
+
+    def thermal(distortion: tuple[float, ...]) -> Stream:
+        t = frame.streams["thermal"]
+        return replace(t, camera=replace(t.camera, distortion=distortion))
+
+    near = Affine.between(thermal((1e-12, 0.0, 0.0, 0.0, 0.0)), colour, 3.0)
+    assert near.scale == pytest.approx((1.75, 1.75)) and near.offset == pytest.approx(
+        (50.875, 239.5 - 1.75 * 119.5)
+    )
+    cam = replace(THERMAL, distortion=(-0.3, 0.1, 0.0, 0.0, 0.0))
+    fitted = Affine.between(thermal(cam.distortion), colour, 3.0)
+    # Barrel distortion packs the thermal image: the fitted scale is larger than 1.75.
+    assert fitted.scale[0] > 1.8 and fitted.scale[1] > 1.8
+    # The thermal image's centre is the lens' centre: mapped where the exact map puts it.
+    centre = COLOUR.project(cam.points_at(159.5, 119.5, 3.0)[None, :] + [0.06, 0.0, 0.0])[0]
+    (sx, sy), (ox, oy) = fitted.scale, fitted.offset
+    assert (sx * 159.5 + ox, sy * 119.5 + oy) == pytest.approx(tuple(centre), abs=0.5)
 
 
 def test_tracker_needs_the_frame_and_method_config_loads() -> None:
@@ -84,6 +110,20 @@ def test_implied_height_of_a_person_on_the_floor_hand_computed() -> None:
     prior = height_log_prior(HeightPrior(), np.array([1.75, 2.25, np.nan]))
     # 2.25 m is 0.2 m = 2 sigma above 2.05 m: -(2^2)/2 = -2
     assert prior.tolist() == pytest.approx([0.0, -2.0, HeightPrior().no_floor])
+
+
+def test_implied_height_follows_the_lens_distortion() -> None:
+    # The same level camera with barrel distortion (k1 = -0.3); the 1.75 m person 2 m away:
+    # its feet (0.55 below the axis) and top (0.325 above) are imaged 9 % and 3 % nearer
+    # the centre, so the pinhole model would put the feet farther away, at 2.2 m, and make
+    # the person 1.79 m tall.
+    cam = replace(THERMAL, distortion=(-0.3, 0.0, 0.0, 0.0, 0.0))
+    pose = Pose((0.0, 0.0, 1.1), (-0.5, 0.5, -0.5, 0.5))
+    feet_top = cam.project(np.array([[0.0, 1.1, 2.0], [0.0, -0.65, 2.0]]))
+    v_feet, v_top = feet_top[:, 1]
+    states = np.array([[159.5, (v_feet + v_top) / 2, v_feet - v_top]])
+    assert implied_heights(cam, pose, states)[0] == pytest.approx(1.75, abs=1e-9)
+    assert implied_heights(replace(cam, distortion=()), pose, states)[0] > 1.78
 
 
 def test_order_on_a_blank_image_puts_the_lower_feet_in_front() -> None:

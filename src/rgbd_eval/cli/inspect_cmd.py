@@ -121,9 +121,10 @@ def _print_human(data: dict[str, Any]) -> None:
             "run refuses this recording until the streams pair (no frame: images not decoded)"
         )
     for role, c in info["cameras"].items():
+        lens = f", {c['distortion_model']} distortion" if any(c["distortion"]) else ""
         console.print(
             f"{role} camera: {c['width']}x{c['height']} fx={c['fx']:.1f} fy={c['fy']:.1f} "
-            f"cx={c['cx']:.1f} cy={c['cy']:.1f} frame {c['frame_id']!r}"
+            f"cx={c['cx']:.1f} cy={c['cy']:.1f} frame {c['frame_id']!r}{lens}"
         )
     if info["has_odometry"]:
         console.print("tf chain: " + " -> ".join(info["tf_chain"]))

@@ -43,8 +43,9 @@ class VoxelGrid:
 def depth_to_cloud(depth: NDArray[np.floating], rays: FloatArray, max_depth: float) -> PointCloud:
     """Back-project a depth image with precomputed unit-depth ``rays`` (``(H, W, 3)``).
 
-    Invalid pixels (NaN, non-positive) and points deeper than ``max_depth`` along
-    the optical axis are dropped, like the thesis' pass-through filter (5.4).
+    Invalid pixels (NaN, non-positive), pixels without a ray (NaN, see
+    :meth:`rgbd_eval.types.CameraModel.rays`) and points deeper than ``max_depth``
+    along the optical axis are dropped, like the thesis' pass-through filter (5.4).
     """
     if rays.shape[:2] != depth.shape:
         raise ValueError(f"rays {rays.shape[:2]} do not match depth image {depth.shape}")
@@ -59,14 +60,14 @@ def _back_project(
     """:func:`depth_to_cloud` over the flat depth image and ``(H * W, 3)`` rays."""
     n = 0
     for i in range(depth.shape[0]):
-        if depth[i] > 0.0 and depth[i] <= max_depth:  # NaN fails both
+        if depth[i] > 0.0 and depth[i] <= max_depth and rays[i, 2] > 0.0:  # NaN fails all
             n += 1
     points = np.empty((n, 3))
     pixels = np.empty(n, dtype=np.int64)
     j = 0
     for i in range(depth.shape[0]):
         d = depth[i]
-        if d > 0.0 and d <= max_depth:
+        if d > 0.0 and d <= max_depth and rays[i, 2] > 0.0:
             z = np.float64(d)
             pixels[j] = i
             for k in range(3):

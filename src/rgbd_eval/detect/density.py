@@ -111,8 +111,7 @@ def camera_density(
     n = _bin_kernel(
         np.ascontiguousarray(depth, dtype=np.float32),
         np.ascontiguousarray(foreground),
-        np.ascontiguousarray(r[0, :, 0]),
-        np.ascontiguousarray(r[:, 0, 1]),
+        np.ascontiguousarray(r),
         T,
         grid.x_min,
         grid.y_min,
@@ -132,8 +131,7 @@ def camera_density(
 def _bin_points(
     depth: NDArray[np.float32],
     foreground: NDArray[np.bool_],
-    ray_x: F64,
-    ray_y: F64,
+    rays: F64,
     T: F64,
     x_min: float,
     y_min: float,
@@ -146,7 +144,7 @@ def _bin_points(
     cells: NDArray[np.int64],
     heights: NDArray[np.float32],
 ) -> int:
-    """Bin the foreground points of one image (rays separable: x by column, y by row).
+    """Bin the foreground points of one image (``rays``: the camera's ``(H, W, 3)`` unit-depth rays).
 
     Adds each kept point's weight to ``sums`` at its cell and records the cell and height;
     returns how many points were kept.
@@ -158,8 +156,8 @@ def _bin_points(
             if not foreground[v, u]:
                 continue
             z = np.float64(depth[v, u])
-            px = ray_x[u] * z
-            py = ray_y[v] * z
+            px = rays[v, u, 0] * z
+            py = rays[v, u, 1] * z
             h = T[2, 0] * px + T[2, 1] * py + T[2, 2] * z + T[2, 3]
             if not h > min_height:
                 continue

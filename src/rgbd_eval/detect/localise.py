@@ -9,11 +9,14 @@ Depth images hold the z coordinate of each point (not the range along the ray), 
 ray is taken with unit z (``image_geometry``'s C++ ``projectPixelTo3dRay``) and scaled by
 the percentile of z: a unit-norm ray times z would place off-axis people too close.
 
+Rays and projections follow each camera's lens distortion (:class:`CameraModel`).
+
 Which depth pixels lie "inside the box": with the depth and colour cameras at the same
-place (identity extrinsics, a registered depth image) every depth pixel maps to the colour
-image independently of its depth, so the box maps to a depth-image rectangle exactly;
-otherwise every valid depth point is projected into the colour image once per frame and
-the points falling in the box are taken, and their z in the colour camera is used.
+place (identity extrinsics, a registered depth image) and the same lens distortion, every
+depth pixel maps to the colour image independently of its depth, so the box maps to a
+depth-image rectangle exactly; otherwise every valid depth point is projected into the
+colour image once per frame and the points falling in the box are taken, and their z in
+the colour camera is used.
 Boxes with no valid depth inside are dropped and counted.
 """
 
@@ -73,6 +76,7 @@ def _box_depths_registered(view: DepthView, box: Box2D) -> FloatArray:
     rc, dc = view.rgb_camera, view.depth_camera
     # A depth pixel (u, v) sees the ray ((u - cx_d)/fx_d, (v - cy_d)/fy_d, 1), which hits the
     # colour image at u_rgb = fx_rgb * (u - cx_d) / fx_d + cx_rgb: affine in u, any depth.
+    # (With the same lens distortion the distorted normalised coordinates match too.)
     u0 = (box.left - rc.cx) * dc.fx / rc.fx + dc.cx
     u1 = (box.right - rc.cx) * dc.fx / rc.fx + dc.cx
     v0 = (box.top - rc.cy) * dc.fy / rc.fy + dc.cy
@@ -108,7 +112,7 @@ class _ProjectedDepth:
 
 def localise(view: DepthView, boxes: Sequence[Box2D]) -> Localisation:
     """World positions of person boxes (III-B); boxes without valid depth are dropped."""
-    registered = _is_identity(view.depth_to_rgb)
+    registered = _is_identity(view.depth_to_rgb) and view.rgb_camera.lens == view.depth_camera.lens
     projected = None if registered or not boxes else _ProjectedDepth(view)
     rgb_to_world = view.camera_pose.compose(view.depth_to_rgb.inverse())
     rc = view.rgb_camera
@@ -123,9 +127,13 @@ def localise(view: DepthView, boxes: Sequence[Box2D]) -> Localisation:
         z = float(np.percentile(values, DEPTH_PERCENTILE))
         u = box.left + 0.5 * box.width
         v = box.top + 0.5 * box.height
-        ray = np.array([(u - rc.cx) / rc.fx, (v - rc.cy) / rc.fy, 1.0])
+        ray = rc.rays_at(u, v)
         world = rgb_to_world.transform_points((ray * z)[None, :])[0]
-        height = box.height * z / rc.fy
+        if rc.lens is None:
+            height = box.height * z / rc.fy
+        else:  # between the rays through the top and bottom centre of the box
+            ends = rc.rays_at([u, u], [box.top, box.bottom])
+            height = float(ends[1, 1] - ends[0, 1]) * z
         out.append(
             LocalisedBox(box, (float(world[0]), float(world[1]), float(world[2])), z, height)
         )

@@ -32,7 +32,7 @@ from rgbd_eval.detect import satake2009_search as search
 from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
 from rgbd_eval.plugins import DetectionContract, DetectorSpec, register_detector
-from rgbd_eval.types import Box2D, Detection, Frame
+from rgbd_eval.types import Box2D, CameraModel, Detection, Frame
 
 
 class Satake2009DetectorConfig(ComponentConfig):
@@ -110,11 +110,9 @@ class Satake2009Contract(DetectionContract):
     detector: Satake2009DetectorConfig | None = None
 
 
-def head_point(
-    cam_fx: float, cam_fy: float, cx: float, cy: float, m: st.Match, D: float
-) -> np.ndarray:
+def head_point(camera: CameraModel, m: st.Match, D: float) -> np.ndarray:
     """Eq. (1) inverted: the head top ``(x, y)`` at distance ``Z_c = D`` in camera coordinates."""
-    return np.array([(m.u - cx) * D / cam_fx, (m.v - cy) * D / cam_fy, D])
+    return camera.points_at(m.u, m.v, D)
 
 
 class Satake2009Detector:
@@ -158,7 +156,7 @@ class Satake2009Detector:
                 rgb, depth, m, D, c.band_m, c.min_head_torso_chroma
             ):
                 continue
-            head = head_point(cam.fx, cam.fy, cam.cx, cam.cy, m, D)[None, :]
+            head = head_point(cam, m, D)[None, :]
             wx, wy, wz = (float(v) for v in left.pose.transform_points(head)[0])
             x, y, w, h = m.box
             box = Box2D(x * sx, y * sy, w * sx, h * sy)

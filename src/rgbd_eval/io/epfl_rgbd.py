@@ -321,21 +321,10 @@ def ground_position(
     keep = valid & (np.abs(window - median) <= TORSO_BAND_M)
     vv, uu = np.nonzero(keep)
     z = window[vv, uu]
-    points = np.stack(
-        [(uu + u0 - camera.cx) * z / camera.fx, (vv + v0 - camera.cy) * z / camera.fy, z], axis=1
-    )
+    points = camera.points_at(uu + u0, vv + v0, z)
     centre = world_T_optical.transform_points(points.mean(axis=0, keepdims=True))[0]
-    u_mid = box.left + box.width / 2.0
-    head = np.array(
-        [
-            [
-                (u_mid - camera.cx) * median / camera.fx,
-                (box.top - camera.cy) * median / camera.fy,
-                median,
-            ]
-        ]
-    )
-    height = float(world_T_optical.transform_points(head)[0, 2])
+    head = camera.points_at(box.left + box.width / 2.0, box.top, median)
+    height = float(world_T_optical.transform_points(head[None, :])[0, 2])
     return (float(centre[0]), float(centre[1]), max(height, 0.0) / 2.0)
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Collection, Iterator, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -208,22 +208,43 @@ def _pose_of(translation: Any, rotation: Any) -> Pose:
     )
 
 
-def camera_model_from_info(msg: Any) -> CameraModel:
-    """``sensor_msgs/CameraInfo`` (ROS1 ``K``/``D`` or ROS2 ``k``/``d``) -> CameraModel."""
+def camera_model_from_info(msg: Any, rectified: bool = False) -> CameraModel:
+    """``sensor_msgs/CameraInfo`` (ROS1 ``K``/``D``/``P`` or ROS2 ``k``/``d``/``p``) -> CameraModel.
+
+    ``rectified``: the image is a rectified one (:func:`is_rectified`). Its CameraInfo (shared
+    with the raw image, as image_proc publishes it) has the raw image's ``K`` and ``D``; the
+    rectified image has no distortion left and the intrinsics of ``P`` (of ``K`` when ``P``
+    is not set). Without distortion in ``D``, ``K`` is taken as for any image.
+    """
     K = np.asarray(msg.K if hasattr(msg, "K") else msg.k, dtype=np.float64).reshape(3, 3)
-    D = np.asarray(msg.D if hasattr(msg, "D") else msg.d, dtype=np.float64)
+    D = tuple(float(v) for v in (msg.D if hasattr(msg, "D") else msg.d))
     P = np.asarray(msg.P if hasattr(msg, "P") else getattr(msg, "p", ()), dtype=np.float64)
+    fx, fy, cx, cy = float(K[0, 0]), float(K[1, 1]), float(K[0, 2]), float(K[1, 2])
+    if rectified and any(D):
+        D = ()
+        if P.size == 12 and P[0] > 0 and P[5] > 0:
+            fx, fy, cx, cy = float(P[0]), float(P[5]), float(P[2]), float(P[6])
     return CameraModel(
         width=int(msg.width),
         height=int(msg.height),
-        fx=float(K[0, 0]),
-        fy=float(K[1, 1]),
-        cx=float(K[0, 2]),
-        cy=float(K[1, 2]),
-        distortion=tuple(float(v) for v in D),
+        fx=fx,
+        fy=fy,
+        cx=cx,
+        cy=cy,
+        distortion=D,
         frame_id=msg.header.frame_id.lstrip("/"),
         tx=float(P[3]) if P.size == 12 else 0.0,
+        distortion_model=str(getattr(msg, "distortion_model", "")),
     )
+
+
+def is_rectified(topic: str) -> bool:
+    """An image topic image_proc rectified: ``.../image_rect``, ``image_rect_color``,
+    ``image_rect_raw`` (a ``compressed`` transport aside)."""
+    parts = topic.rstrip("/").split("/")
+    if parts[-1] in ("compressed", "compressedDepth"):
+        parts = parts[:-1]
+    return bool(parts) and parts[-1].startswith("image_rect")
 
 
 def _namespace(topic: str) -> str:
@@ -1111,7 +1132,7 @@ def _cameras(
                 info_topic,
             )
         if msg is None:
-            colour = _registered_camera(path, sel, index, first, cameras)
+            colour = _registered_camera(path, sel, index, first, cameras, warnings)
             img = first[topic]
             left = cameras.get("left")
             if role_kind(role) == "disparity" and left is not None:
@@ -1147,7 +1168,7 @@ def _cameras(
                 f"no CameraInfo for this image topic (choose it with --topic {role}_info=/name)",
                 topic,
             )
-        cameras[role] = _camera(path, info_topic, msg, first[topic], topic)
+        cameras[role] = _camera(path, info_topic, msg, first[topic], topic, warnings)
     return {role: cameras[role] for role in sel.streams}
 
 
@@ -1157,6 +1178,7 @@ def _registered_camera(
     index: _Index,
     first: Mapping[str, Any],
     cameras: Mapping[str, CameraModel],
+    warnings: list[str],
 ) -> CameraModel | None:
     """The model of the colour camera of :attr:`SelectedTopics.registration`, if usable."""
     if sel.registration is None:
@@ -1165,26 +1187,32 @@ def _registered_camera(
         return cameras["colour"]
     topic, info_topic = sel.registration
     msg = index.first_msgs.get(info_topic)
-    return None if msg is None else _camera(path, info_topic, msg, first[topic], topic)
+    return None if msg is None else _camera(path, info_topic, msg, first[topic], topic, warnings)
 
 
-def _camera(path: Path, info_topic: str | None, msg: Any, first: Any, topic: str) -> CameraModel:
+def _camera(
+    path: Path, info_topic: str | None, msg: Any, first: Any, topic: str, warnings: list[str]
+) -> CameraModel:
+    """The camera model of ``topic`` from its CameraInfo ``msg``; what of the distortion is
+    not applied goes to ``warnings``."""
     first = first.image if hasattr(first, "f") else first  # a DisparityImage's image
+    rectified = is_rectified(topic)
     try:
-        camera = camera_model_from_info(msg)
+        camera = camera_model_from_info(msg, rectified)
     except ValueError as err:
         raise DecodeError(path, f"bad CameraInfo: {err}", info_topic) from err
     if not camera.frame_id:
-        camera = CameraModel(
-            camera.width,
-            camera.height,
-            camera.fx,
-            camera.fy,
-            camera.cx,
-            camera.cy,
-            camera.distortion,
-            first.header.frame_id.lstrip("/"),
+        camera = replace(camera, frame_id=first.header.frame_id.lstrip("/"))
+    notes = []
+    if rectified and any(msg.D if hasattr(msg, "D") else msg.d):
+        notes.append(
+            f"{topic} is rectified: the {camera.distortion_model} distortion in {info_topic} "
+            "describes the raw image and is not applied (intrinsics from its P, where set)"
         )
+    problem = camera.distortion_problem()
+    if problem is not None:
+        notes.append(f"{info_topic}: {problem}")
+    warnings.extend(n for n in notes if n not in warnings)  # once per camera
     return camera
 
 

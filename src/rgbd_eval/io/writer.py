@@ -316,7 +316,7 @@ class RecordingWriter:
             header=self.header(stamp_ns, camera.frame_id, topic),
             height=camera.height,
             width=camera.width,
-            distortion_model="plumb_bob",
+            distortion_model=camera.distortion_model,
             binning_x=0,
             binning_y=0,
             roi=roi,

@@ -148,10 +148,23 @@ class Affine:
 
     @staticmethod
     def between(thermal: Stream, colour: Stream, depth_m: float) -> Affine:
-        """Parallel cameras: the intrinsics ratio, and the baseline's parallax at ``depth_m``."""
+        """Parallel cameras: the intrinsics ratio, and the baseline's parallax at ``depth_m``.
+
+        With lens distortion the map is not affine: the affine map (per axis) fitted by least
+        squares to a grid of thermal pixels carried to the colour image at ``depth_m``.
+        """
         t, c = thermal.camera, colour.camera
         colour_T_thermal = colour.pose.inverse().compose(thermal.pose)
         bx, by, _ = colour_T_thermal.translation
+        if t.lens is not None or c.lens is not None:
+            u, v = np.meshgrid(np.linspace(0, t.width - 1, 17), np.linspace(0, t.height - 1, 13))
+            points = t.points_at(u.ravel(), v.ravel(), depth_m) + np.array([bx, by, 0.0])
+            uv = c.project(points)
+            (sx, ox), (sy, oy) = (
+                np.polyfit(u.ravel(), uv[:, 0], 1),
+                np.polyfit(v.ravel(), uv[:, 1], 1),
+            )
+            return Affine((float(sx), float(sy)), (float(ox), float(oy)))
         sx, sy = c.fx / t.fx, c.fy / t.fy
         return Affine(
             (sx, sy),
@@ -524,7 +537,7 @@ def _ground_point(stream: Stream, u: float, v: float) -> tuple[float, float]:
     """Where the ray through pixel (u, v) meets the floor (world z = 0); the camera's own
     ground position when the ray does not go down."""
     cam = stream.camera
-    ray = np.array([(u - cam.cx) / cam.fx, (v - cam.cy) / cam.fy, 1.0])
+    ray = cam.rays_at(u, v)
     R = stream.pose.rotation_matrix()
     d = R @ ray
     o = np.asarray(stream.pose.translation, dtype=np.float64)

@@ -42,8 +42,7 @@ class HeightPrior:
 
 def _rays(camera: CameraModel, rotation: F64, u: F64, v: F64) -> F64:
     """World directions (N, 3) of the rays through pixels (u, v)."""
-    r = np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones_like(u)], 1)
-    out: F64 = r @ rotation.T
+    out: F64 = camera.rays_at(u, v) @ rotation.T
     return out
 
 

@@ -193,7 +193,7 @@ class Satake2009Tracker:
                     rgb, sd.depth, m, D, self.det.band_m, self.det.min_head_torso_chroma
                 ):
                     continue
-            head = head_point(cam.fx, cam.fy, cam.cx, cam.cy, m, D)[None, :]
+            head = head_point(cam, m, D)[None, :]
             world = left.pose.transform_points(head)[0]
             y = to_robot(robot, (float(world[0]), float(world[1]), float(world[2])))
             r = y - ekf.H @ t.x
@@ -213,8 +213,7 @@ class Satake2009Tracker:
     ) -> st.Match | None:
         """The best template around one track's projected head top, if it scores enough."""
         cfg, D = self.cfg, float(head[2])
-        u = cam.fx * float(head[0]) / D + cam.cx
-        v = cam.fy * float(head[1]) / D + cam.cy
+        u, v = (float(c) for c in cam.project(head[None, :])[0])
         S = ekf.innovation_covariance(t.P, cfg.sigma_v)
         sigma = math.sqrt(float(np.linalg.eigvalsh(S[:2, :2])[-1]))
         radius = min(
