@@ -97,3 +97,73 @@ def test_cli_exit_codes(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "schema version 99" in result.output
     result = runner.invoke(app, ["compare", str(base), str(cur), "--tolerance", "speed=1"])
     assert result.exit_code == 2 and "METRIC=VALUE" in result.output
+
+
+PROVENANCE = {
+    "generator": "rgbd-eval synth",
+    "tool_version": "0.1.0",
+    "renderer_version": 2,
+    "scenario": "demo",
+    "scenario_sha256": "11" * 32,
+    "scenario_file_sha256": "22" * 32,
+    "seed": 7,
+    "frames": 150,
+    "container": "mcap",
+    "closed_loop": None,
+}
+
+
+def test_same_provenance_other_bytes_is_compared_with_a_note() -> None:
+    base = report(0.9, 0.04, 2)
+    base["sequences"][0]["provenance"] = dict(PROVENANCE)
+    base["machine"] = {"cpu": "AMD EPYC", "flags": "avx2 fma"}
+    base["libraries"] = {"mcap": "1.2.0"}
+    cur = copy.deepcopy(base)
+    cur["sequences"][0]["sha256"] = "cd" * 32
+    cur["machine"] = {"cpu": "Intel Xeon", "flags": "avx2 fma avx512f"}
+    c = compare_reports(base, cur)
+    assert c.regressions == ()
+    (note,) = c.notes
+    assert "differ in bytes" in note and "one provenance" in note and "seed 7" in note
+    assert "machine.cpu: 'AMD EPYC' -> 'Intel Xeon'" in note
+    assert "mcap" not in note  # the same library versions are not listed
+
+
+@pytest.mark.parametrize(
+    ("change", "named"),
+    [
+        ({"seed": 8}, "seed: 7 -> 8"),
+        ({"renderer_version": 3}, "renderer_version: 2 -> 3"),
+        ({"scenario_sha256": "33" * 32}, "scenario_sha256"),
+    ],
+)
+def test_other_provenance_is_refused_naming_what_differs(
+    change: dict[str, Any], named: str
+) -> None:
+    base = report(0.9, 0.04, 2)
+    base["sequences"][0]["provenance"] = dict(PROVENANCE)
+    cur = copy.deepcopy(base)
+    cur["sequences"][0]["sha256"] = "cd" * 32
+    cur["sequences"][0]["provenance"].update(change)
+    with pytest.raises(CompareInputError, match="different provenance") as err:
+        compare_reports(base, cur)
+    assert named in str(err.value)
+    # the file digest alone (a comment edited in the scenario file) is not part of the identity
+    same = copy.deepcopy(base)
+    same["sequences"][0]["sha256"] = "cd" * 32
+    same["sequences"][0]["provenance"]["scenario_file_sha256"] = "44" * 32
+    assert len(compare_reports(base, same).notes) == 1
+
+
+def test_cli_prints_the_note_and_gates_on_the_metrics(tmp_path: Path) -> None:
+    base = report(0.9, 0.04, 2)
+    base["sequences"][0]["provenance"] = dict(PROVENANCE)
+    cur = copy.deepcopy(base)
+    cur["sequences"][0]["sha256"] = "cd" * 32
+    a, b = tmp_path / "a.json", tmp_path / "b.json"
+    a.write_text(json.dumps(base))
+    b.write_text(json.dumps(cur))
+    result = runner.invoke(app, ["compare", str(a), str(b), "--markdown", str(tmp_path / "c.md")])
+    assert result.exit_code == 0, result.output
+    assert "note: sequence 'demo': the recordings differ in bytes" in result.stderr
+    assert "Notes:" in (tmp_path / "c.md").read_text()

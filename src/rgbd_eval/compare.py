@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import Any
 
 from rgbd_eval.errors import CompareInputError
+from rgbd_eval.io import provenance
 from rgbd_eval.report import REPORT_SCHEMA_VERSION
 
 
@@ -71,6 +72,8 @@ class Delta:
 class Comparison:
     deltas: tuple[Delta, ...]
     config_changes: tuple[str, ...]
+    #: What a reader must know besides the deltas (recordings of one provenance that differ).
+    notes: tuple[str, ...] = ()
 
     @property
     def regressions(self) -> tuple[Delta, ...]:
@@ -203,11 +206,11 @@ def compare_reports(
         raise CompareInputError(
             f"different datasets: baseline has {sorted(base_seqs)}, current has {sorted(cur_seqs)}"
         )
-    for name, seq in base_seqs.items():
-        if seq.get("sha256") != cur_seqs[name].get("sha256"):
-            raise CompareInputError(
-                f"different datasets: sequence {name!r} has different content (sha256)"
-            )
+    notes = [
+        note
+        for name in sorted(base_seqs)
+        if (note := _same_recording(name, baseline, current)) is not None
+    ]
     conventions = [
         r["evaluation"].get("convention", _LEGACY_CONVENTION) for r in (baseline, current)
     ]
@@ -258,7 +261,57 @@ def compare_reports(
         for k in sorted(set(flat_b) | set(flat_c))
         if flat_b.get(k) != flat_c.get(k)
     )
-    return Comparison(tuple(deltas), changes)
+    return Comparison(tuple(deltas), changes, tuple(notes))
+
+
+def _same_recording(
+    name: str, baseline: Mapping[str, Any], current: Mapping[str, Any]
+) -> str | None:
+    """None when sequence ``name`` read the same bytes in both reports; a note when the bytes
+    differ but the recordings have one provenance; CompareInputError otherwise."""
+    base = next(s for s in baseline["sequences"] if s["name"] == name)
+    cur = next(s for s in current["sequences"] if s["name"] == name)
+    if base.get("sha256") == cur.get("sha256"):
+        return None
+    prov_b, prov_c = base.get("provenance"), cur.get("provenance")
+    prov_b = prov_b if isinstance(prov_b, Mapping) else None
+    prov_c = prov_c if isinstance(prov_c, Mapping) else None
+    differ = provenance.differences(prov_b, prov_c)
+    if differ or prov_b is None:
+        raise CompareInputError(
+            f"different datasets: sequence {name!r} has different content (sha256) and "
+            f"different provenance ({'; '.join(differ)})"
+        )
+    made = (
+        f"scenario {prov_b.get('scenario')!r} sha256 {str(prov_b.get('scenario_sha256'))[:12]}, "
+        f"seed {prov_b.get('seed')}, {prov_b.get('frames')} frames, "
+        f"rgbd-eval {prov_b.get('tool_version')} renderer {prov_b.get('renderer_version')}"
+    )
+    env = _environment_differences(baseline, current)
+    return (
+        f"sequence {name!r}: the recordings differ in bytes (sha256 "
+        f"{str(base.get('sha256'))[:12]} vs {str(cur.get('sha256'))[:12]}) but have one "
+        f"provenance ({made}); "
+        + (
+            f"the reports' machines or libraries differ: {'; '.join(env)}"
+            if env
+            else "the reports name the same machine and libraries"
+        )
+        + "; compared as the same recording"
+    )
+
+
+def _environment_differences(baseline: Mapping[str, Any], current: Mapping[str, Any]) -> list[str]:
+    """``key: a -> b`` for the machine and library versions the two reports name differently."""
+    out = []
+    for section in ("machine", "libraries"):
+        a, b = baseline.get(section), current.get(section)
+        a = a if isinstance(a, Mapping) else {}
+        b = b if isinstance(b, Mapping) else {}
+        for key in sorted(set(a) | set(b)):
+            if a.get(key) != b.get(key):
+                out.append(f"{section}.{key}: {a.get(key)!r} -> {b.get(key)!r}")
+    return out
 
 
 def _fmt(value: float | None, metric: str) -> str:
@@ -312,4 +365,6 @@ def markdown(comparison: Comparison) -> str:
     lines += ["", verdict]
     if comparison.config_changes:
         lines += ["", "Config changes:", *(f"- `{c}`" for c in comparison.config_changes)]
+    if comparison.notes:
+        lines += ["", "Notes:", *(f"- {n}" for n in comparison.notes)]
     return "\n".join(lines) + "\n"

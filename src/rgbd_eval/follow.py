@@ -22,7 +22,9 @@ and whether the followed id is still on the target. Same scenario and seed, same
 from __future__ import annotations
 
 import csv
+import hashlib
 import io
+import json
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -35,8 +37,9 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.atomic import write_json, write_text
-from rgbd_eval.config import RunConfig, load_config
+from rgbd_eval.config import RunConfig, config_to_dict, load_config
 from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import write_csv
@@ -49,11 +52,11 @@ from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig
 from rgbd_eval.sim.synth import (
     SynthContainer,
     ground_truth_path,
+    provenance,
     stream_options,
     write_frame,
     write_static,
 )
-from rgbd_eval.track import satake2009_ekf as ekf
 from rgbd_eval.track.protocol import create_tracker
 from rgbd_eval.types import Frame, GroundTruthObject, Pose, Stream, TrackOutput
 
@@ -102,7 +105,7 @@ def path_c_wheel_speeds(X: float, Y: float, v: float, k: float, d: float) -> tup
 
 def wheel_command(X: float, Y: float, c: FollowControl) -> tuple[float, float]:
     """Path C at the distance-scaled speed, both wheels scaled into ``[-v_max, v_max]``."""
-    r = math.hypot(X, Y)
+    r = exact.hypot(X, Y)
     v = c.v * min(1.0, max(0.0, (r - c.stop_m) / (c.full_m - c.stop_m)))
     v_L, v_R = path_c_wheel_speeds(X, Y, v, c.k, c.d)
     top = max(abs(v_L), abs(v_R))
@@ -114,11 +117,23 @@ def wheel_command(X: float, Y: float, c: FollowControl) -> tuple[float, float]:
 def drive(
     pose: tuple[float, float, float], v_L: float, v_R: float, d: float, dt: float
 ) -> tuple[float, float, float]:
-    """The planar pose after ``dt`` at wheel speeds ``(v_L, v_R)`` (the arc of 2.3.1)."""
-    m = ekf.robot_motion(v_L, v_R, d, dt)
+    """The planar pose after ``dt`` at wheel speeds ``(v_L, v_R)`` (the arc of 2.3.1).
+
+    The arithmetic of :func:`rgbd_eval.track.satake2009_ekf.robot_motion`, in
+    :mod:`rgbd_eval.exact`: the simulated robot's path is part of the recording, the same on
+    every CPU.
+    """
+    if not d > 0:
+        raise ValueError(f"half wheel separation d={d} must be > 0")
+    v = 0.5 * (v_R + v_L)
+    d_theta = (v_R - v_L) / (2.0 * d) * dt
+    half = d_theta / 2.0
+    s_half, c_half = exact.sincos(half)
+    d_L = v * dt * (s_half / half if half != 0.0 else 1.0)  # 2 rho sin(d_theta/2)
+    d_X, d_Y = d_L * c_half, d_L * s_half
     x, y, yaw = pose
-    c, s = math.cos(yaw), math.sin(yaw)
-    return (x + c * m.d_X - s * m.d_Y, y + s * m.d_X + c * m.d_Y, yaw + m.d_theta)
+    s, c = exact.sincos(yaw)
+    return (x + c * d_X - s * d_Y, y + s * d_X + c * d_Y, yaw + d_theta)
 
 
 def in_robot_frame(
@@ -126,7 +141,7 @@ def in_robot_frame(
 ) -> tuple[float, float]:
     """A world ground point as ``(X forward, Y left)`` of planar robot pose ``pose``."""
     x, y, yaw = pose
-    c, s = math.cos(yaw), math.sin(yaw)
+    s, c = exact.sincos(yaw)
     dx, dy = point[0] - x, point[1] - y
     return c * dx + s * dy, -s * dx + c * dy
 
@@ -323,6 +338,9 @@ def follow(
             writer = stack.enter_context(
                 RecordingWriter(out_path, container, options, overwrite=True)
             )
+            loop = json.dumps({"target": target, "config": config_to_dict(cfg)}, sort_keys=True)
+            digest = hashlib.sha256(loop.encode("utf-8")).hexdigest()
+            writer.write_provenance(scenario.stamp_ns(0), provenance(sim, n, container, digest))
             write_static(writer, sim, sensors)
         for i in range(n):
             c0 = time.process_time()
@@ -385,7 +403,7 @@ def _step(
 ) -> tuple[FollowStep, int | None, bool]:
     """Judge one frame and choose the wheel speeds; returns the step, the lock and lost."""
     if locked is None and where is not None:
-        near = [(math.hypot(o.x - where[0], o.y - where[1]), o.track_id) for o in tracks]
+        near = [(exact.hypot(o.x - where[0], o.y - where[1]), o.track_id) for o in tracks]
         near = [(dist, tid) for dist, tid in near if dist <= c.lock_m]
         locked = min(near)[1] if near else None
     followed = next((o for o in tracks if o.track_id == locked), None)
@@ -394,7 +412,7 @@ def _step(
     if locked is not None:
         lost = lost or followed is None
         if followed is not None and where is not None:
-            error = math.hypot(followed.x - where[0], followed.y - where[1])
+            error = exact.hypot(followed.x - where[0], followed.y - where[1])
         status = (
             "lost"
             if lost
@@ -402,12 +420,15 @@ def _step(
         )
     v_L = v_R = 0.0
     if followed is not None and not lost:
-        X, Y = in_robot_frame(odom, (followed.x, followed.y))  # what the robot believes
+        # what the robot believes, to the millimetre: the tracker's last bits (BLAS, libm)
+        # differ between CPUs, the robot's path (part of the recording) must not
+        seen = (round(followed.x * 1000.0) / 1000.0, round(followed.y * 1000.0) / 1000.0)
+        X, Y = in_robot_frame(odom, seen)
         v_L, v_R = wheel_command(X, Y, c)
     dist = bearing = None
     if where is not None:
         X, Y = in_robot_frame(pose, where)
-        dist, bearing = math.hypot(X, Y), math.degrees(math.atan2(Y, X))
+        dist, bearing = exact.hypot(X, Y), math.degrees(exact.atan2(Y, X))
     step = FollowStep(
         frame=index,
         stamp_ns=stamp_ns,

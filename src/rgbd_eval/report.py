@@ -18,6 +18,7 @@ from typing import Any
 
 from rgbd_eval import __version__
 from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
+from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
 from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.pipeline import SequenceResult
@@ -173,6 +174,7 @@ def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
         "world_frame": info.world_frame,
         "sync": asdict(info.sync),
         "warnings": list(info.warnings),
+        "provenance": None if info.provenance is None else dict(info.provenance),
         "skipped_messages": [asdict(s) for s in info.skipped],  # damaged, per topic
         "ground_truth": None
         if gt is None
@@ -199,6 +201,7 @@ def report_dict(
         "schema_version": REPORT_SCHEMA_VERSION,
         "tool": {"name": "rgbd-eval", "version": __version__},
         "libraries": library_versions(),
+        "machine": machine_info(),
         "method": config.method,
         "evaluation": {
             "gating": gating.value,

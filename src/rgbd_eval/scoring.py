@@ -18,6 +18,7 @@ from rgbd_eval import __version__
 from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
 from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
+from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
 from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.report import (
@@ -90,6 +91,7 @@ def report_dict(
         "schema_version": REPORT_SCHEMA_VERSION,
         "tool": {"name": "rgbd-eval", "version": __version__},
         "libraries": library_versions(),
+        "machine": machine_info(),
         "method": "external tracker output",
         "evaluation": {
             "gating": config.gating.value,

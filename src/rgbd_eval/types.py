@@ -16,12 +16,15 @@ from __future__ import annotations
 
 import enum
 import functools
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+
+from rgbd_eval import exact
 
 FloatArray = NDArray[np.float64]
 
@@ -95,11 +98,11 @@ def _matrix_to_quat(R: FloatArray) -> tuple[float, float, float, float]:
             (m[1, 2] + m[2, 1]) / s,
             0.25 * s,
         )
-    q = np.array([x, y, z, w], dtype=float)
-    q /= np.linalg.norm(q)
-    if q[3] < 0:
-        q = -q
-    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+    x, y, z, w = float(x), float(y), float(z), float(w)
+    n = math.sqrt(x * x + y * y + z * z + w * w)  # in a fixed order: not BLAS (exact.py)
+    if w < 0:
+        n = -n
+    return (x / n, y / n, z / n, w / n)
 
 
 @dataclass(frozen=True)
@@ -134,21 +137,19 @@ class Pose:
 
     def compose(self, other: Pose) -> Pose:
         """``self * other``: if self is a_T_b and other is b_T_c, the result is a_T_c."""
-        return Pose.from_matrix(self.matrix() @ other.matrix())
+        return Pose.from_matrix(exact.matmul(self.matrix(), other.matrix()))
 
     def inverse(self) -> Pose:
         R = self.rotation_matrix()
         t = np.asarray(self.translation)
         T = np.eye(4)
         T[:3, :3] = R.T
-        T[:3, 3] = -R.T @ t
+        T[:3, 3] = -exact.matmul(t, R)  # -R^T t
         return Pose.from_matrix(T)
 
     def transform_points(self, points: FloatArray) -> FloatArray:
         """Apply to an ``(N, 3)`` array of points."""
-        pts = np.asarray(points, dtype=np.float64)
-        out: FloatArray = pts @ self.rotation_matrix().T + np.asarray(self.translation)
-        return out
+        return exact.transform(points, self.rotation_matrix(), self.translation)
 
 
 #: body_T_optical for a camera: optical (x right, y down, z forward) -> body (x fwd, y left, z up).

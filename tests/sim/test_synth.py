@@ -148,3 +148,57 @@ def test_synthesize_all_writes_every_scenario(
     assert [r.recording.name for r in results] == ["one.bag", "two.bag"]
     assert (tmp_path / "out" / "two.gt.csv").exists()
     assert seen[-1] == ("two", 6, 6) and len(seen) == 12
+
+
+@pytest.mark.parametrize("suffix", [".mcap", ".bag"])
+def test_the_recording_carries_its_provenance(tmp_path: Path, suffix: str) -> None:
+    from rgbd_eval import __version__
+    from rgbd_eval.io import provenance
+    from rgbd_eval.sim.scenario import load_scenario, scenarios_dir
+    from rgbd_eval.sim.synth import RENDERER_VERSION
+
+    path = scenarios_dir() / "demo.yaml"
+    sc = load_scenario(path)
+    rec = open_recording(synthesize(sc, tmp_path / f"p{suffix}", seed=9, max_frames=2).recording)
+    prov = rec.info.provenance
+    assert prov is not None
+    import hashlib
+
+    assert prov == {
+        "generator": "rgbd-eval synth",
+        "tool_version": __version__,
+        "renderer_version": RENDERER_VERSION,
+        "scenario": "demo",
+        "scenario_sha256": sc.digest(),
+        "scenario_file_sha256": hashlib.sha256(path.read_bytes()).hexdigest(),
+        "seed": 9,
+        "frames": 2,
+        "container": "ros1" if suffix == ".bag" else "mcap",
+        "closed_loop": None,
+    }
+    # an override changes the resolved scenario's digest, not the file's
+    other = load_scenario(path, [("sensor.rgb_noise_std", 1.0)])
+    assert other.digest() != sc.digest() and other.source_sha256 == sc.source_sha256
+    assert provenance.differences(prov, {**prov, "seed": 1}) == ["seed: 9 -> 1"]
+
+
+def test_a_damaged_provenance_is_skipped_with_a_warning(tmp_path: Path) -> None:
+    from rgbd_eval.io import provenance
+    from rgbd_eval.io.writer import RecordingWriter
+
+    sc = tiny_scenario()
+    good = synthesize(sc, tmp_path / "g.mcap", seed=0, max_frames=1).recording
+    # the same recording with a provenance message that is not JSON
+    bad = tmp_path / "b.mcap"
+    with RecordingWriter(bad) as w:
+        msg = w._t(provenance.PROVENANCE_TYPE)(data="{not json")
+        w.write_message(provenance.PROVENANCE_TOPIC, provenance.PROVENANCE_TYPE, 1, msg)
+        from rgbd_eval.io.source import open_source
+
+        with open_source(good) as src:
+            for topic, log_ns, raw in src.messages(set(src.topics) - {provenance.PROVENANCE_TOPIC}):
+                msgtype = src.topics[topic].msgtype
+                w.write_message(topic, msgtype, log_ns, src.deserialize(raw, msgtype))
+    rec = open_recording(bad)
+    assert rec.info.provenance is None
+    assert any("provenance" in w and "not JSON" in w for w in rec.info.warnings)

@@ -56,6 +56,8 @@ def compare(
         console.print(table)
     for change in comparison.config_changes:
         console.print(f"config: {change}")
+    for note in comparison.notes:
+        typer.echo(f"note: {one_line(note)}", err=True)
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison))
     if html_file is not None:

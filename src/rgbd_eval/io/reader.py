@@ -38,7 +38,7 @@ from rgbd_eval.errors import (
     TransformError,
 )
 from rgbd_eval.files import check_input
-from rgbd_eval.io import groundtruth, images, integrity, validate, wheels
+from rgbd_eval.io import groundtruth, images, integrity, provenance, validate, wheels
 from rgbd_eval.io.integrity import SkippedMessages
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
@@ -172,6 +172,8 @@ class RecordingInfo:
     warnings: tuple[str, ...] = field(default_factory=tuple)
     #: Damaged messages skipped per topic (:mod:`rgbd_eval.io.integrity`).
     skipped: tuple[SkippedMessages, ...] = field(default_factory=tuple)
+    #: Where a synthetic recording came from (:mod:`rgbd_eval.io.provenance`); None otherwise.
+    provenance: Mapping[str, Any] | None = None
 
     @property
     def rgb_camera(self) -> CameraModel | None:
@@ -273,6 +275,8 @@ class _Index:
     odom_frames: tuple[str, str] | None = None
     gt_objects: list[Any] = field(default_factory=list)
     gt_messages: int = 0
+    #: The recording's provenance (:mod:`rgbd_eval.io.provenance`), when it has one.
+    provenance: dict[str, Any] | None = None
 
 
 @dataclass(frozen=True)
@@ -909,6 +913,7 @@ def open_recording(
         num_frames=len(plan),
         warnings=tuple(warnings),
         skipped=skipped,
+        provenance=index.provenance,
     )
     log_ns = {
         topic: np.asarray(index.image_log_ns.get(topic, []), dtype=np.int64)
@@ -1012,6 +1017,9 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfi
     small = {t for t in (sel.odometry, sel.ground_truth, sel.joint_states) if t} | infos
     odometer = wheels.WheelOdometry(0.5 * io.wheels.separation_m) if io.wheels is not None else None
     small.update(sel.tf)
+    prov = src.topics.get(provenance.PROVENANCE_TOPIC)
+    if prov is not None and prov.msgtype == provenance.PROVENANCE_TYPE:
+        small.add(provenance.PROVENANCE_TOPIC)
     wanted = small | images_
     for topic, log_ns, raw in src.messages(wanted):
         msgtype = src.topics[topic].msgtype
@@ -1081,6 +1089,12 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfi
                     static,
                     topic,
                 )
+        elif topic == provenance.PROVENANCE_TOPIC:
+            if index.provenance is None:
+                try:
+                    index.provenance = provenance.decode(str(msg.data))
+                except ValueError as err:
+                    index.skips.add(topic, str(err))
         elif topic == sel.ground_truth:
             frame = index.gt_messages
             index.gt_messages += 1

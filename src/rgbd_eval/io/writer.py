@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import os
 import shutil
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
@@ -24,7 +25,7 @@ from rosbags.rosbag1 import Writer as Ros1Writer
 from rosbags.rosbag2 import StoragePlugin
 from rosbags.rosbag2 import Writer as Ros2Writer
 
-from rgbd_eval.io import images
+from rgbd_eval.io import images, provenance
 from rgbd_eval.io.messages import (
     CAMERA_INFO_TYPE,
     COMPRESSED_IMAGE_TYPE,
@@ -274,6 +275,11 @@ class RecordingWriter:
         """``parent_T_child`` on ``/tf_static``."""
         msg = self._t(TF_TYPE)(transforms=[self._transform(stamp_ns, parent, child, pose)])
         self.write_message(TF_STATIC_TOPIC, TF_TYPE, stamp_ns, msg)
+
+    def write_provenance(self, stamp_ns: int, record: Mapping[str, Any]) -> None:
+        """Where the recording came from, as JSON on :data:`provenance.PROVENANCE_TOPIC`."""
+        msg = self._t(provenance.PROVENANCE_TYPE)(data=provenance.encode(record))
+        self.write_message(provenance.PROVENANCE_TOPIC, provenance.PROVENANCE_TYPE, stamp_ns, msg)
 
     def write_odometry(self, stamp_ns: int, frame_id: str, child_frame_id: str, pose: Pose) -> None:
         """``nav_msgs/Odometry`` on ``/odom`` (pose ``frame_id_T_child``, zero twist)."""

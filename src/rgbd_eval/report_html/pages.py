@@ -363,6 +363,7 @@ def compare_page(comparison: Comparison, baseline: str, current: str) -> str:
         rows=rows,
         regressions=len(comparison.regressions),
         config_changes=comparison.config_changes,
+        notes=comparison.notes,
         chart=data_uri(plots.delta_grid(sequences, metrics, cells)),
     )
 

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rgbd_eval import exact
 from rgbd_eval.sim.meshes import (
     F64,
     MAT_SKIN,
@@ -60,8 +61,8 @@ def _c(colour: Colour) -> tuple[float, float, float]:
 
 def _dir(angle: float, side: float = 0.0) -> F64:
     """Unit vector hanging down, rotated forward by ``angle`` and out sideways by ``side``."""
-    v = np.array([math.sin(angle), side, -math.cos(angle)])
-    out: F64 = v / np.linalg.norm(v)
+    v = np.array([exact.sin(angle), side, -exact.cos(angle)])
+    out: F64 = v / exact.norm(v)
     return out
 
 
@@ -70,9 +71,10 @@ def leg_angles(posture: Posture) -> tuple[tuple[float, float], tuple[float, floa
     out = []
     for offset in (0.0, math.pi):
         ph = posture.phase + offset
-        hip = math.radians(HIP_SWING_DEG) * posture.amplitude * math.sin(ph)
+        hip = math.radians(HIP_SWING_DEG) * posture.amplitude * exact.sin(ph)
         # the knee flexes while the leg swings forward (hip flexion increasing)
-        knee = math.radians(KNEE_SWING_DEG) * posture.amplitude * max(0.0, math.cos(ph)) ** 2
+        bend = max(0.0, exact.cos(ph))
+        knee = math.radians(KNEE_SWING_DEG) * posture.amplitude * (bend * bend)
         knee += math.radians(5.0) * posture.amplitude
         hip = hip * (1.0 - posture.sit) + math.radians(88.0) * posture.sit
         knee = knee * (1.0 - posture.sit) + math.radians(88.0) * posture.sit
@@ -103,7 +105,7 @@ def figure_mesh(
 
     # legs: place the pelvis so that the lower foot rests on the floor
     legs = leg_angles(posture)
-    lowest = min(-thigh * math.cos(h) - shank * math.cos(h - k) for h, k in legs)
+    lowest = min(-thigh * exact.cos(h) - shank * exact.cos(h - k) for h, k in legs)
     hip_z = ankle - lowest
     drop = HIP_Z * H - hip_z  # how much the upper body is lowered (gait bob, sitting)
     for side, (hip, knee) in zip((1.0, -1.0), legs, strict=True):
@@ -140,7 +142,7 @@ def figure_mesh(
 
     # arms swing opposite to the legs
     for side, sign in ((1.0, -1.0), (-1.0, 1.0)):
-        swing = sign * math.radians(ARM_SWING_DEG) * posture.amplitude * math.sin(posture.phase)
+        swing = sign * math.radians(ARM_SWING_DEG) * posture.amplitude * exact.sin(posture.phase)
         swing = swing * (1.0 - posture.sit) + math.radians(25.0) * posture.sit
         elbow = math.radians(12.0 + 18.0 * posture.amplitude + 45.0 * posture.sit)
         sh = np.array([sit_back, side * 0.195 * s, z(SHOULDER_Z - 0.02)])
@@ -163,8 +165,8 @@ def figure_mesh(
 
     local = b.build()
     R = rotation_z(heading)
-    verts = local.vertices @ R.T + np.array([x, y, 0.0])
-    normals = local.normals @ R.T
+    verts = exact.transform(local.vertices, R, (x, y, 0.0))
+    normals = exact.matmul(local.normals, R.T)
     mesh = Mesh(verts, normals, local.triangles, local.colours, local.object_ids, local.materials)
     top = float(local.vertices[:, 2].max())
     return mesh, top

@@ -15,6 +15,8 @@ from functools import lru_cache
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
+
 F64 = NDArray[np.float64]
 I32 = NDArray[np.int32]
 
@@ -46,10 +48,10 @@ def unit_sphere(n_lat: int = 8, n_lon: int = 12) -> tuple[F64, I32]:
     """Unit sphere at the origin (vertices double as normals)."""
     verts = [(0.0, 0.0, 1.0)]
     for i in range(1, n_lat):
-        th = math.pi * i / n_lat
+        sin_th, cos_th = exact.sincos(math.pi * i / n_lat)
         for j in range(n_lon):
-            ph = 2.0 * math.pi * j / n_lon
-            verts.append((math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)))
+            sin_ph, cos_ph = exact.sincos(2.0 * math.pi * j / n_lon)
+            verts.append((sin_th * cos_ph, sin_th * sin_ph, cos_th))
     verts.append((0.0, 0.0, -1.0))
     tris: list[tuple[int, int, int]] = []
     for j in range(n_lon):
@@ -71,8 +73,7 @@ def unit_sphere(n_lat: int = 8, n_lon: int = 12) -> tuple[F64, I32]:
 @lru_cache(maxsize=8)
 def unit_cylinder(n: int = 12) -> tuple[F64, F64, I32]:
     """Radius-1 cylinder along z from 0 to 1, capped; returns (vertices, normals, triangles)."""
-    ang = 2.0 * np.pi * np.arange(n) / n
-    c, s = np.cos(ang), np.sin(ang)
+    s, c = exact.sincos(2.0 * np.pi * np.arange(n) / n)
     side = np.concatenate([np.stack([c, s, np.zeros(n)], 1), np.stack([c, s, np.ones(n)], 1)])
     side_n = np.concatenate([np.stack([c, s, np.zeros(n)], 1)] * 2)
     bottom = np.concatenate([[[0.0, 0.0, 0.0]], np.stack([c, s, np.zeros(n)], 1)])
@@ -118,19 +119,9 @@ def unit_box() -> tuple[F64, F64, I32]:
     return np.asarray(verts), np.asarray(normals), np.asarray(tris, dtype=np.int32)
 
 
-def rotation_z(yaw: float) -> F64:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-
-
-def rotation_y(pitch: float) -> F64:
-    c, s = math.cos(pitch), math.sin(pitch)
-    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
-
-
-def rotation_x(roll: float) -> F64:
-    c, s = math.cos(roll), math.sin(roll)
-    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+rotation_x = exact.rotation_x
+rotation_y = exact.rotation_y
+rotation_z = exact.rotation_z
 
 
 def affine(linear: F64, translation: F64 | tuple[float, float, float]) -> F64:
@@ -144,14 +135,14 @@ def affine(linear: F64, translation: F64 | tuple[float, float, float]) -> F64:
 def segment_frame(a: F64, b: F64) -> F64:
     """A rotation whose z axis points from ``a`` to ``b``."""
     d = np.asarray(b, dtype=np.float64) - np.asarray(a, dtype=np.float64)
-    n = float(np.linalg.norm(d))
+    n = float(exact.norm(d))
     if n < 1e-12:
         return np.eye(3)
     z = d / n
     helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
+    x = exact.cross(helper, z)
+    x /= exact.norm(x)
+    y = exact.cross(z, x)
     return np.stack([x, y, z], axis=1)
 
 
@@ -179,10 +170,10 @@ class MeshBuilder:
     ) -> None:
         """Add a primitive mapped by the 4x4 affine ``M``."""
         L = M[:3, :3]
-        v = verts @ L.T + M[:3, 3]
-        n = normals @ np.linalg.inv(L)  # (L^-T n^T)^T
-        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
-        if np.linalg.det(L) < 0:
+        v = exact.transform(verts, L, M[:3, 3])
+        n = exact.matmul(normals, exact.inv3(L))  # (L^-T n^T)^T
+        n /= np.maximum(exact.norm(n), 1e-12)[:, None]
+        if exact.det3(L) < 0:
             tris = tris[:, ::-1]
         self._v.append(v)
         self._n.append(n)
@@ -204,7 +195,9 @@ class MeshBuilder:
     ) -> None:
         """An ellipsoid with semi-axes ``radii`` along the columns of ``R``."""
         v, t = unit_sphere()
-        self.add(v, v, t, affine(R @ np.diag(radii), centre), colour, object_id, material)
+        self.add(
+            v, v, t, affine(exact.matmul(R, np.diag(radii)), centre), colour, object_id, material
+        )
 
     def limb(
         self,
@@ -220,10 +213,16 @@ class MeshBuilder:
         a = np.asarray(a, dtype=np.float64)
         b = np.asarray(b, dtype=np.float64)
         R = segment_frame(a, b)
-        length = float(np.linalg.norm(b - a))
+        length = float(exact.norm(b - a))
         v, n, t = unit_cylinder()
         self.add(
-            v, n, t, affine(R @ np.diag([radius, radius, length]), a), colour, object_id, material
+            v,
+            n,
+            t,
+            affine(exact.matmul(R, np.diag([radius, radius, length])), a),
+            colour,
+            object_id,
+            material,
         )
         if joint:
             self.sphere(b, (radius, radius, radius), np.eye(3), colour, object_id, material)
@@ -238,7 +237,9 @@ class MeshBuilder:
         material: int = MAT_MATTE,
     ) -> None:
         v, n, t = unit_box()
-        self.add(v, n, t, affine(R @ np.diag(size), centre), colour, object_id, material)
+        self.add(
+            v, n, t, affine(exact.matmul(R, np.diag(size)), centre), colour, object_id, material
+        )
 
     def cylinder(
         self,

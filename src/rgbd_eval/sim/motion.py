@@ -11,6 +11,7 @@ import bisect
 import math
 from dataclasses import dataclass
 
+from rgbd_eval import exact
 from rgbd_eval.sim.scenario import Follow, Person, Robot
 
 #: Time to sit down or to stand up (s).
@@ -56,13 +57,13 @@ def person_timeline(person: Person) -> list[Segment]:
     heading = 0.0
     if len(person.path) > 1:
         nxt = person.path[1]
-        heading = math.atan2(nxt.y - first.y, nxt.x - first.x)
+        heading = exact.atan2(nxt.y - first.y, nxt.x - first.x)
     for i, wp in enumerate(person.path):
         target = (wp.x, wp.y)
         if i > 0:
-            length = math.hypot(target[0] - pos[0], target[1] - pos[1])
+            length = exact.hypot(target[0] - pos[0], target[1] - pos[1])
             if length > 1e-9:
-                heading = math.atan2(target[1] - pos[1], target[0] - pos[0])
+                heading = exact.atan2(target[1] - pos[1], target[0] - pos[0])
                 dt = length / wp.speed
                 segs.append(Segment(t, t + dt, "walk", pos, target, heading, s))
                 t += dt
@@ -107,7 +108,7 @@ def person_state(person: Person, segments: list[Segment], t: float) -> PersonSta
 
 def follower_state(leader: PersonState, follow: Follow) -> PersonState:
     """A follower's state: the leader's, shifted right/behind in the leader's frame."""
-    c, s = math.cos(leader.heading), math.sin(leader.heading)
+    c, s = exact.cos(leader.heading), exact.sin(leader.heading)
     fwd, left = -follow.behind_m, -follow.right_m
     return PersonState(
         leader.present,
@@ -172,7 +173,7 @@ def robot_timeline(robot: Robot) -> list[RobotSegment]:
         target = (wp.x, wp.y)
         length = math.dist(pos, target)
         if length > 1e-9:
-            want = math.atan2(target[1] - pos[1], target[0] - pos[0])
+            want = exact.atan2(target[1] - pos[1], target[0] - pos[0])
             dyaw = _wrap(want - yaw)
             if abs(dyaw) > 1e-9:
                 dt = abs(dyaw) / rate

@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim.annotate import projected_extent
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.simulate import Simulator
@@ -75,7 +76,7 @@ def pair_scenario(rng: np.random.Generator, illumination: float = 1.0) -> Scenar
     bearings = (bearing, bearing + float(rng.uniform(-0.12, 0.12)))
     people = []
     for pid, (dist, b) in enumerate(zip((near, far), bearings, strict=True), start=1):
-        x, y = dist, dist * math.tan(b)
+        x, y = dist, dist * exact.tan(b)
         heading = float(rng.uniform(0.0, 2.0 * math.pi))
         step = float(rng.uniform(0.3, 0.6))
         people.append(
@@ -85,7 +86,7 @@ def pair_scenario(rng: np.random.Generator, illumination: float = 1.0) -> Scenar
                 "shirt": _colour(rng),
                 "trousers": _colour(rng),
                 "path": [
-                    {"x": x - step * math.cos(heading), "y": y - step * math.sin(heading)},
+                    {"x": x - step * exact.cos(heading), "y": y - step * exact.sin(heading)},
                     {"x": x, "y": y, "speed": 1.2},
                 ],
             }
@@ -206,7 +207,7 @@ def _clipped(box: Box, size: tuple[float, float]) -> Box:
 
 def _jittered(box: Box, jitter: float, rng: np.random.Generator) -> Box:
     h = box[3] - box[1]
-    d = rng.normal(0.0, jitter * h, size=4)
+    d = exact.standard_normal(rng, 4) * (jitter * h)
     u0, v0, u1, v1 = (float(box[k] + d[k]) for k in range(4))
     return (min(u0, u1 - 1.0), min(v0, v1 - 1.0), max(u1, u0 + 1.0), max(v1, v0 + 1.0))
 

@@ -14,6 +14,7 @@ import math
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim.scenario import Odometry
 
 F64 = NDArray[np.float64]
@@ -22,7 +23,7 @@ F64 = NDArray[np.float64]
 def relative_motion(p0: F64, p1: F64) -> tuple[float, float, float]:
     """(forward, lateral, dyaw) of pose p1 seen from pose p0, poses as (x, y, yaw)."""
     dx, dy = p1[0] - p0[0], p1[1] - p0[1]
-    c, s = math.cos(p0[2]), math.sin(p0[2])
+    c, s = exact.cos(p0[2]), exact.sin(p0[2])
     dyaw = (p1[2] - p0[2] + math.pi) % (2.0 * math.pi) - math.pi
     return (c * dx + s * dy, -s * dx + c * dy, dyaw)
 
@@ -37,17 +38,17 @@ def integrate_odometry(true_poses: F64, model: Odometry, rng: np.random.Generato
     if n == 0:
         return out
     out[0] = poses[0]
-    noise = rng.standard_normal((n, 3))
+    noise = exact.standard_normal(rng, (n, 3))
     rot_sigma = math.radians(model.rotation_noise_deg)
     for i in range(1, n):
         fwd, lat, dyaw = relative_motion(poses[i - 1], poses[i])
-        dist = math.hypot(fwd, lat)
+        dist = exact.hypot(fwd, lat)
         fwd *= 1.0 + model.scale_error
         lat *= 1.0 + model.scale_error
         fwd += noise[i, 0] * model.translation_noise * math.sqrt(dist)
         lat += noise[i, 1] * model.translation_noise * math.sqrt(dist)
         dyaw += noise[i, 2] * rot_sigma * math.sqrt(dist + abs(dyaw))
         x, y, yaw = out[i - 1]
-        c, s = math.cos(yaw), math.sin(yaw)
+        c, s = exact.cos(yaw), exact.sin(yaw)
         out[i] = (x + c * fwd - s * lat, y + s * fwd + c * lat, yaw + dyaw)
     return out

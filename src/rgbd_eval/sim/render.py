@@ -1,8 +1,10 @@
-"""Ray casting with Open3D: depth, object ids and shaded colour in one pass per camera.
+"""Rendering: depth, triangle ids and shaded colour of what each camera pixel sees.
 
-Rays have unit z in the camera's optical frame, so the hit distance ``t_hit``
-is directly the depth z. Shading is Lambertian with a hemispheric ambient
-term, smooth (barycentric) vertex normals and a tiled floor.
+Rays go through pixel centres with unit z in the camera's optical frame, so the hit
+distance is directly the depth z. The ray casting is our own (:mod:`rgbd_eval.sim.raster`)
+and every step after it uses :mod:`rgbd_eval.exact`, so a scenario renders to the same
+bytes on every CPU. Shading is Lambertian with a hemispheric ambient term, smooth
+(barycentric) vertex normals and a tiled floor.
 """
 
 from __future__ import annotations
@@ -10,163 +12,171 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Any
 
 import numpy as np
-import open3d as o3d
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim.meshes import MAT_FLOOR, Mesh
+from rgbd_eval.sim.raster import RayBundle, binned_rays, pixel_rays
 from rgbd_eval.sim.world import NO_HIT
 from rgbd_eval.types import CameraModel, Pose
 
 F64 = NDArray[np.float64]
+F32 = NDArray[np.float32]
 I32 = NDArray[np.int32]
 
 BACKGROUND = 25.0
-_INVALID = np.uint32(0xFFFFFFFF)
 
 
 @dataclass(frozen=True)
 class Hits:
     """What one camera sees: depth z (NaN: nothing), triangle index (-1: nothing), ray data."""
 
-    depth: NDArray[np.float32]  # (H, W)
+    depth: F32  # (H, W)
     triangle: I32  # (H, W)
-    uv: NDArray[np.float32]  # (H, W, 2) barycentric coordinates
-    face_normals: NDArray[np.float32]  # (H, W, 3) geometric normals of the hit triangles
+    uv: F32  # (H, W, 2) barycentric coordinates
+    face_normals: F32  # (H, W, 3) unit geometric normals of the hit triangles
     origin: F64  # (3,) world ray origin
-    directions: NDArray[np.float32]  # (H, W, 3) world ray directions (unit optical z)
+    directions: F32  # (H, W, 3) world ray directions (unit optical z)
 
-    def points(self) -> NDArray[np.float32]:
+    def points(self) -> F32:
         """World hit points (H, W, 3), NaN where nothing was hit."""
         o = self.origin.astype(np.float32)
-        out: NDArray[np.float32] = o + self.directions * self.depth[..., None]
+        out: F32 = o + self.directions * self.depth[..., None]
         return out
 
 
-def camera_rays(
-    camera: CameraModel, pose: Pose, pixels: F64 | None = None
-) -> tuple[F64, NDArray[np.floating[Any]]]:
-    """World ray origin (3,) and directions (..., 3) through pixel centres (or ``pixels`` (N, 2))."""
-    if pixels is None:
-        d = _optical_rays(camera.width, camera.height, camera.fx, camera.fy, camera.cx, camera.cy)
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """Triangles to cast rays against: world vertices and per-triangle unit normals."""
+
+    vertices: F64  # (V, 3)
+    triangles: I32  # (T, 3)
+    face_normals: F32  # (T, 3)
+
+    @property
+    def n_triangles(self) -> int:
+        return int(self.triangles.shape[0])
+
+
+def make_scene(mesh: Mesh) -> Scene:
+    """The ray-casting scene of ``mesh``."""
+    v = np.ascontiguousarray(mesh.vertices, dtype=np.float64)
+    t = np.ascontiguousarray(mesh.triangles, dtype=np.int32)
+    if len(t):
+        a, b, c = v[t[:, 0]], v[t[:, 1]], v[t[:, 2]]
+        n = exact.cross(b - a, c - a)
+        n = n / np.maximum(exact.norm(n), 1e-300)[:, None]
     else:
-        d = np.stack(
-            [
-                (pixels[:, 0] - camera.cx) / camera.fx,
-                (pixels[:, 1] - camera.cy) / camera.fy,
-                np.ones(len(pixels)),
-            ],
-            axis=1,
+        n = np.zeros((0, 3))
+    return Scene(v, t, n.astype(np.float32))
+
+
+def to_frame(points: F64, pose: Pose) -> F64:
+    """World points (N, 3) in the frame of ``pose`` (world_T_frame): R^T (p - t)."""
+    R = pose.rotation_matrix()
+    return exact.matmul(np.asarray(points, dtype=np.float64) - np.asarray(pose.translation), R)
+
+
+@lru_cache(maxsize=16)
+def _camera_rays(
+    width: int, height: int, fx: float, fy: float, cx: float, cy: float
+) -> tuple[F64, NDArray[np.int64]]:
+    d, cells = pixel_rays(width, height, fx, fy, cx, cy)
+    d.setflags(write=False)
+    cells.setflags(write=False)
+    return d, cells
+
+
+class CameraCast:
+    """One camera's pixel rays from a pose, with the nearest hits cast so far."""
+
+    def __init__(self, camera: CameraModel, pose: Pose) -> None:
+        self.camera = camera
+        self.pose = pose
+        c = camera
+        d, cells = _camera_rays(c.width, c.height, c.fx, c.fy, c.cx, c.cy)
+        self._bundle = RayBundle(d, cells, (c.fx, c.fy, c.cx, c.cy), (c.width, c.height))
+        R = pose.rotation_matrix()
+        world = exact.matmul(d, R.T).astype(np.float32).reshape(c.height, c.width, 3)
+        world.setflags(write=False)
+        #: World ray directions (H, W, 3), shared by the copies.
+        self.directions = world
+
+    def copy(self) -> CameraCast:
+        """The same rays and hits, to be cast into independently."""
+        out = object.__new__(CameraCast)
+        out.__dict__.update(self.__dict__)
+        out._bundle = self._bundle.copy()
+        return out
+
+    def cast(self, scene: Scene, triangle_offset: int = 0) -> None:
+        """Keep the nearer hits of ``scene``; its triangle ids are shifted by ``triangle_offset``."""
+        self._bundle.cast(to_frame(scene.vertices, self.pose), scene.triangles, triangle_offset)
+
+    def hits(self, face_normals: F32) -> Hits:
+        """The hits so far; ``face_normals`` (T, 3) of every triangle id that was cast."""
+        b = self._bundle
+        h, w = self.camera.height, self.camera.width
+        hit = b.triangle >= 0
+        depth = np.where(hit, b.t, np.nan).astype(np.float32)
+        uv = np.stack([b.u, b.v], axis=1).astype(np.float32)
+        normals = np.zeros((len(hit), 3), dtype=np.float32)
+        normals[hit] = face_normals[b.triangle[hit]]
+        return Hits(
+            depth.reshape(h, w),
+            b.triangle.reshape(h, w),
+            uv.reshape(h, w, 2),
+            normals.reshape(h, w, 3),
+            np.asarray(self.pose.translation, dtype=np.float64),
+            self.directions,
         )
-    R = pose.rotation_matrix().astype(d.dtype)
-    return np.asarray(pose.translation, dtype=np.float64), d @ R.T
 
 
-@lru_cache(maxsize=8)
-def _optical_rays(
-    w: int, h: int, fx: float, fy: float, cx: float, cy: float
-) -> NDArray[np.float32]:
-    rays = CameraModel(w, h, fx, fy, cx, cy).rays().astype(np.float32)
-    rays.setflags(write=False)
-    return rays
-
-
-def make_scene(mesh: Mesh) -> o3d.t.geometry.RaycastingScene:
-    """An Open3D ray-casting scene holding ``mesh`` as one geometry."""
-    scene = o3d.t.geometry.RaycastingScene()
-    if mesh.n_triangles:
-        scene.add_triangles(
-            o3d.core.Tensor.from_numpy(np.ascontiguousarray(mesh.vertices, dtype=np.float32)),
-            o3d.core.Tensor.from_numpy(np.ascontiguousarray(mesh.triangles, dtype=np.uint32)),
-        )
-    return scene
-
-
-def cast(
-    scene: o3d.t.geometry.RaycastingScene, origin: F64, directions: NDArray[np.floating[Any]]
-) -> tuple[NDArray[np.float32], I32, NDArray[np.float32], NDArray[np.float32]]:
-    """Cast rays: (t_hit, NaN for misses; triangle index or -1; barycentric uv; face normal)."""
-    shape = directions.shape[:-1]
-    flat = directions.reshape(-1, 3)
-    rays = np.empty((flat.shape[0], 6), dtype=np.float32)
-    rays[:, :3] = origin
-    rays[:, 3:] = flat
-    out = scene.cast_rays(o3d.core.Tensor.from_numpy(rays), nthreads=1)
-    t = out["t_hit"].numpy()
-    t[~np.isfinite(t)] = np.nan  # misses come back as +inf
-    tri = out["primitive_ids"].numpy().view(np.int32)  # the invalid id 0xFFFFFFFF is -1
-    uv = out["primitive_uvs"].numpy()
-    fn = out["primitive_normals"].numpy()
-    return t.reshape(shape), tri.reshape(shape), uv.reshape(*shape, 2), fn.reshape(*shape, 3)
-
-
-def render_hits(scene: o3d.t.geometry.RaycastingScene, camera: CameraModel, pose: Pose) -> Hits:
+def render_hits(scene: Scene, camera: CameraModel, pose: Pose) -> Hits:
     """Cast one ray per pixel of ``camera`` placed at ``pose`` (world_T_optical)."""
-    origin, dirs = camera_rays(camera, pose)
-    depth, tri, uv, fn = cast(scene, origin, dirs)
-    return Hits(depth, tri, uv, fn, origin, dirs.astype(np.float32))
-
-
-def overlay_hits(
-    base: Hits,
-    scene: o3d.t.geometry.RaycastingScene,
-    window: tuple[int, int, int, int],
-    triangle_offset: int,
-) -> Hits:
-    """``base`` with the nearer hits of a second scene cast inside ``window`` (u0, v0, u1, v1).
-
-    Casting the same rays against two scenes and keeping the nearer hit equals one
-    cast against their union; the second scene's triangle indices are shifted by
-    ``triangle_offset`` (its place in the concatenated mesh). Rendering the static
-    scene once and only the people's image region per frame is what keeps a
-    static camera fast.
-    """
-    u0, v0, u1, v1 = window
-    H, W = base.triangle.shape
-    if not (0 <= u0 <= u1 <= W and 0 <= v0 <= v1 <= H):
-        raise ValueError(f"window={window} must lie inside the {W}x{H} image")
-    depth, tri, uv, fn = (
-        base.depth.copy(),
-        base.triangle.copy(),
-        base.uv.copy(),
-        base.face_normals.copy(),
-    )
-    if u1 > u0 and v1 > v0:
-        dirs = base.directions[v0:v1, u0:u1]
-        t, t_tri, t_uv, t_fn = cast(scene, base.origin, dirs)
-        old = depth[v0:v1, u0:u1]
-        nearer = (t_tri >= 0) & ~(t >= old)  # also where the base saw nothing (NaN)
-        depth[v0:v1, u0:u1] = np.where(nearer, t, old)
-        tri[v0:v1, u0:u1] = np.where(nearer, t_tri + triangle_offset, tri[v0:v1, u0:u1])
-        uv[v0:v1, u0:u1] = np.where(nearer[..., None], t_uv, uv[v0:v1, u0:u1])
-        fn[v0:v1, u0:u1] = np.where(nearer[..., None], t_fn, fn[v0:v1, u0:u1])
-    return Hits(depth, tri, uv, fn, base.origin, base.directions)
+    cast = CameraCast(camera, pose)
+    cast.cast(scene)
+    return cast.hits(scene.face_normals)
 
 
 def occluded_towards(
-    scenes: list[o3d.t.geometry.RaycastingScene], points: NDArray[np.float32], target: F64
+    scenes: list[Scene], points: F32 | F64, target: F64, rotation: F64
 ) -> NDArray[np.bool_]:
     """For world points (N, 3): is the segment to ``target`` blocked in any of ``scenes``?
 
-    Each segment starts 1 cm off its point, so a surface does not shadow itself
-    unless it faces away from the target.
+    Each segment ends 1 cm off its point, so a surface does not shadow itself unless it
+    faces away from the target. ``rotation`` (world_R_frame) orients a frame at
+    ``target`` in which the points lie ahead (z > 0); points that do not are reported
+    as not blocked.
     """
-    if len(points) == 0:
-        return np.zeros(0, dtype=bool)
-    p = points.astype(np.float64)
-    d = target - p
-    length = np.linalg.norm(d, axis=1, keepdims=True)
-    start = p + d * (np.minimum(0.01, 0.5 * length) / np.maximum(length, 1e-9))
-    rays = np.empty((len(p), 6), dtype=np.float32)
-    rays[:, :3] = start
-    rays[:, 3:] = target - start
-    tensor = o3d.core.Tensor.from_numpy(rays)
+    p = np.asarray(points, dtype=np.float64)
     blocked = np.zeros(len(p), dtype=bool)
+    if len(p) == 0:
+        return blocked
+    tgt = np.asarray(target, dtype=np.float64)
+    d = tgt - p
+    length = exact.norm(d)
+    end = p + d * (np.minimum(0.01, 0.5 * length) / np.maximum(length, 1e-9))[:, None]
+    frame = Pose.from_matrix(_homogeneous(rotation, tgt))
+    rays = to_frame(end, frame)
+    ahead = np.flatnonzero(rays[:, 2] > 1e-9)
+    if ahead.size == 0:
+        return blocked
+    cells, grid, size = binned_rays(rays[ahead])
+    bundle = RayBundle(rays[ahead], cells, grid, size, t_max=np.ones(ahead.size))
     for scene in scenes:
-        blocked |= scene.test_occlusions(tensor, tfar=1.0, nthreads=1).numpy().astype(bool)
+        bundle.cast(to_frame(scene.vertices, frame), scene.triangles)
+    blocked[ahead] = bundle.triangle >= 0
     return blocked
+
+
+def _homogeneous(rotation: F64, translation: F64) -> F64:
+    T = np.eye(4)
+    T[:3, :3] = rotation
+    T[:3, 3] = translation
+    return T
 
 
 def object_ids(mesh: Mesh, hits: Hits) -> I32:
@@ -178,8 +188,9 @@ def object_ids(mesh: Mesh, hits: Hits) -> I32:
 
 def light_direction(azimuth_deg: float, elevation_deg: float) -> F64:
     """Unit vector towards the light (world, z up)."""
-    az, el = math.radians(azimuth_deg), math.radians(elevation_deg)
-    return np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    sa, ca = exact.sincos(azimuth_deg * (exact.PI / 180.0))
+    se, ce = exact.sincos(elevation_deg * (exact.PI / 180.0))
+    return np.array([ce * ca, ce * sa, se])
 
 
 def floor_pattern(points: NDArray[np.float32], tile: float) -> NDArray[np.float32]:
@@ -218,13 +229,17 @@ def shade(mesh: Mesh, hits: Hits, light: F64, floor_tile: float) -> NDArray[np.f
         n[curved] = c[:, 0] * (1.0 - u - v) + c[:, 1] * u + c[:, 2] * v
     d = hits.directions.reshape(-1, 3)
     # unit length, turned towards the camera (shade the side that is seen)
-    sign = np.where(np.einsum("ij,ij->i", n, d) > 0, np.float32(-1.0), np.float32(1.0))
-    n *= (sign / np.maximum(np.sqrt(np.einsum("ij,ij->i", n, n)), np.float32(1e-6)))[:, None]
-    lambert = np.clip(n @ light.astype(np.float32), 0.0, None)
+    facing = n[:, 0] * d[:, 0] + n[:, 1] * d[:, 1] + n[:, 2] * d[:, 2]
+    sign = np.where(facing > 0, np.float32(-1.0), np.float32(1.0))
+    length = np.sqrt(n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1] + n[:, 2] * n[:, 2])
+    n *= (sign / np.maximum(length, np.float32(1e-6)))[:, None]
+    lx, ly, lz = (np.float32(c) for c in light)
+    lambert = np.clip(n[:, 0] * lx + n[:, 1] * ly + n[:, 2] * lz, 0.0, None)
     intensity = np.float32(0.38) + np.float32(0.12) * n[:, 2] + np.float32(0.62) * lambert
     out = colour * intensity[:, None]
     out[~hit] = BACKGROUND
-    return out.reshape(H, W, 3)
+    image: NDArray[np.float32] = out.reshape(H, W, 3)
+    return image
 
 
 def count_hits(
@@ -240,10 +255,13 @@ def count_hits(
     if area == 0 or mesh.n_triangles == 0:
         return 0.0
     step = max(1, math.ceil(math.sqrt(area / 8000.0)))
-    us = np.arange(u0, u1, step, dtype=np.float64)
-    vs = np.arange(v0, v1, step, dtype=np.float64)
-    uu, vv = np.meshgrid(us, vs)
-    pixels = np.stack([uu.ravel(), vv.ravel()], axis=1)
-    origin, dirs = camera_rays(camera, pose, pixels)
-    _, tri, _, _ = cast(make_scene(mesh), origin, dirs)
-    return float(np.count_nonzero(tri >= 0) * step * step)
+    # a grid whose cell (i, j) is the image pixel (u0 + i step, v0 + j step)
+    nw, nh = len(range(u0, u1, step)), len(range(v0, v1, step))
+    grid = (camera.fx / step, camera.fy / step, (camera.cx - u0) / step, (camera.cy - v0) / step)
+    us = (np.arange(u0, u1, step, dtype=np.float64) - camera.cx) / camera.fx
+    vs = (np.arange(v0, v1, step, dtype=np.float64) - camera.cy) / camera.fy
+    d = np.empty((nh, nw, 3))
+    d[..., 0], d[..., 1], d[..., 2] = us[None, :], vs[:, None], 1.0
+    bundle = RayBundle(d.reshape(-1, 3), np.arange(nw * nh, dtype=np.int64), grid, (nw, nh))
+    bundle.cast(to_frame(mesh.vertices, pose), mesh.triangles)
+    return float(np.count_nonzero(bundle.triangle >= 0) * step * step)

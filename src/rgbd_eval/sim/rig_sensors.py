@@ -23,6 +23,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import BaseModel, ConfigDict, Field
 
+from rgbd_eval import exact
 from rgbd_eval.sim.meshes import rotation_y, rotation_z
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose
 
@@ -147,8 +148,8 @@ def pinhole_from_fov(
     width: int, height: int, hfov_deg: float, vfov_deg: float, frame_id: str
 ) -> CameraModel:
     """An undistorted camera with the given fields of view, principal point at the centre."""
-    fx = (width / 2.0) / math.tan(math.radians(hfov_deg) / 2.0)
-    fy = (height / 2.0) / math.tan(math.radians(vfov_deg) / 2.0)
+    fx = (width / 2.0) / exact.tan(math.radians(hfov_deg) / 2.0)
+    fy = (height / 2.0) / exact.tan(math.radians(vfov_deg) / 2.0)
     return CameraModel(
         width, height, fx, fy, (width - 1) / 2.0, (height - 1) / 2.0, (0.0,) * 5, frame_id
     )
@@ -165,7 +166,9 @@ class StaticDepthCamera:
             c.width, c.height, c.hfov_deg, c.vfov_deg, f"{c.name}_optical_frame"
         )
         body = np.eye(4)
-        body[:3, :3] = rotation_z(math.radians(c.yaw_deg)) @ rotation_y(math.radians(c.pitch_deg))
+        body[:3, :3] = exact.matmul(
+            rotation_z(math.radians(c.yaw_deg)), rotation_y(math.radians(c.pitch_deg))
+        )
         body[:3, 3] = (c.x, c.y, c.z)
         #: world_T_optical
         self.pose = Pose.from_matrix(body).compose(OPTICAL_TO_BODY)

@@ -11,6 +11,8 @@ frame coincides with odometry's ``odom`` frame at t = 0.
 from __future__ import annotations
 
 import enum
+import hashlib
+import json
 import math
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -20,12 +22,14 @@ from pydantic import (
     BaseModel,
     ConfigDict,
     Field,
+    PrivateAttr,
     SerializeAsAny,
     ValidationError,
     field_validator,
     model_validator,
 )
 
+from rgbd_eval import exact
 from rgbd_eval.config import config_dir, format_validation_error, load_yaml, set_dotted
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.sim.rig_sensors import RigSensorConfig, rig_sensor_config
@@ -326,11 +330,11 @@ class Sensor(_Model):
 
     @property
     def fx(self) -> float:
-        return (self.width / 2.0) / math.tan(math.radians(self.hfov_deg) / 2.0)
+        return (self.width / 2.0) / exact.tan(math.radians(self.hfov_deg) / 2.0)
 
     @property
     def fy(self) -> float:
-        return (self.height / 2.0) / math.tan(math.radians(self.vfov_deg) / 2.0)
+        return (self.height / 2.0) / exact.tan(math.radians(self.vfov_deg) / 2.0)
 
 
 class Odometry(_Model):
@@ -357,6 +361,9 @@ class Recording(_Model):
 
 class Scenario(_Model):
     """One synthetic recording."""
+
+    #: sha256 of the file the scenario was read from (None when built in code).
+    _source_sha256: str | None = PrivateAttr(default=None)
 
     name: str = Field(min_length=1, max_length=100, pattern=r"^[A-Za-z0-9_.-]+$")
     description: str = ""
@@ -417,6 +424,16 @@ class Scenario(_Model):
         return self
 
     @property
+    def source_sha256(self) -> str | None:
+        """sha256 of the scenario file it was read from, if any."""
+        return self._source_sha256
+
+    def digest(self) -> str:
+        """sha256 of the resolved scenario (every value, overrides applied) as canonical JSON."""
+        text = json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+    @property
     def n_frames(self) -> int:
         return max(1, round(self.duration_s * self.sensor.rate_hz))
 
@@ -449,7 +466,9 @@ def load_scenario(path: Path | str, overrides: Iterable[tuple[str, Any]] = ()) -
             set_dotted(data, key, value, Scenario)
         except ConfigError as err:
             raise ConfigError(f"{p}: {err}") from err
-    return parse_scenario(data, str(p))
+    scenario = parse_scenario(data, str(p))
+    scenario._source_sha256 = hashlib.sha256(p.read_bytes()).hexdigest()
+    return scenario
 
 
 def scenarios_dir() -> Path:

@@ -24,6 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
+from rgbd_eval import exact
 from rgbd_eval.sim.scenario import Sensor
 
 F32 = NDArray[np.float32]
@@ -69,7 +70,7 @@ def noisy_depth(
     if z.shape != dropout.shape:
         raise ValueError(f"dropout shape {dropout.shape} differs from depth shape {z.shape}")
     bf = sensor.baseline_m * focal_px
-    gauss = rng.standard_normal(z.shape)
+    gauss = exact.standard_normal(rng, z.shape)
     uniform = rng.random(z.shape)
     valid = np.isfinite(z) & (z > 0)
     zz = np.where(valid, z, 1.0).astype(np.float64)
@@ -101,8 +102,8 @@ def exposure_gain(t: float, amplitude: float, period_s: float) -> float:
     """Slow auto-exposure drift: two incommensurate sines around 1."""
     if period_s <= 0:
         raise ValueError(f"period_s={period_s} must be positive")
-    a = math.sin(2.0 * math.pi * t / period_s)
-    b = math.sin(2.0 * math.pi * t / (0.37 * period_s) + 1.0)
+    a = exact.sin(2.0 * math.pi * t / period_s)
+    b = exact.sin(2.0 * math.pi * t / (0.37 * period_s) + 1.0)
     return 1.0 + amplitude * (0.7 * a + 0.3 * b)
 
 
@@ -110,7 +111,7 @@ def noise_bank(shape: tuple[int, ...], count: int, rng: np.random.Generator) -> 
     """``count`` standard-normal noise images (drawing fresh noise per frame is the slowest step)."""
     if count < 1:
         raise ValueError(f"count={count} must be at least 1")
-    bank: F32 = rng.standard_normal((count, *shape), dtype=np.float32)
+    bank: F32 = exact.standard_normal(rng, (count, *shape), dtype=np.float32)
     return bank
 
 

@@ -13,11 +13,10 @@ from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
-import open3d as o3d
 from numpy.typing import NDArray
 
 from rgbd_eval.sim import rig
-from rgbd_eval.sim.annotate import NEAR_M, person_ground_truth, projected_extent
+from rgbd_eval.sim.annotate import person_ground_truth
 from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.meshes import MAT_SHINY, MAT_SKIN, Mesh, concatenate
 from rgbd_eval.sim.motion import (
@@ -32,13 +31,13 @@ from rgbd_eval.sim.motion import (
 )
 from rgbd_eval.sim.odometry import integrate_odometry
 from rgbd_eval.sim.render import (
+    CameraCast,
     Hits,
+    Scene,
     light_direction,
     make_scene,
     object_ids,
     occluded_towards,
-    overlay_hits,
-    render_hits,
     shade,
 )
 from rgbd_eval.sim.rig_sensors import SceneView
@@ -68,32 +67,6 @@ _NOISE_BANK = 4
 
 def _rng(seed: int, stream: int, index: int = 0) -> np.random.Generator:
     return np.random.default_rng([seed, stream, index])
-
-
-def people_window(people: Mesh, camera: CameraModel, pose: Pose) -> tuple[int, int, int, int]:
-    """Image window (u0, v0, u1, v1) that holds every pixel the people can cover.
-
-    The projected vertices bound the people's pixels unless a triangle crosses the
-    plane near the camera; then the whole image is used.
-    """
-    if people.n_triangles == 0:
-        return (0, 0, 0, 0)
-    z = pose.inverse().transform_points(people.vertices)[:, 2]
-    if np.all(z <= NEAR_M):
-        return (0, 0, 0, 0)
-    if np.any(z <= NEAR_M):
-        return (0, 0, camera.width, camera.height)
-    extent = projected_extent(people.vertices, camera, pose)
-    if extent is None:  # pragma: no cover - all vertices are in front here
-        return (0, 0, 0, 0)
-    u0, v0, u1, v1 = extent
-    # pixel centres (edge coordinate - 0.5) inside the extent, one pixel of margin
-    return (
-        min(max(math.floor(u0 - 0.5) - 1, 0), camera.width),
-        min(max(math.floor(v0 - 0.5) - 1, 0), camera.height),
-        min(max(math.ceil(u1 - 0.5) + 2, 0), camera.width),
-        min(max(math.ceil(v1 - 0.5) + 2, 0), camera.height),
-    )
 
 
 @dataclass(frozen=True, eq=False)
@@ -129,11 +102,11 @@ class Simulator:
         self.link_to_depth = rig.camera_link_to_depth(s)
         self.static = static_mesh(scenario.room, scenario.obstacles)
         self._static_scene = make_scene(self.static)
-        #: Static-scene hits per camera model (size, intrinsics and frame id): the pose they
-        #: were cast from, and the hits.
-        self._static_hits: dict[CameraModel, tuple[Pose, Hits]] = {}
+        #: Static-scene casts per camera model (size, intrinsics and frame id), with the pose
+        #: they were cast from.
+        self._static_casts: dict[CameraModel, CameraCast] = {}
         #: The people of the last rendered frame (index, mesh, scene), reused by scene_view.
-        self._people: tuple[int, Mesh, o3d.t.geometry.RaycastingScene] | None = None
+        self._people: tuple[int, Mesh, Scene] | None = None
         self.light = light_direction(s.light_azimuth_deg, s.light_elevation_deg)
         leaders = {p.id: p for p in scenario.people if p.follow is None}
         timelines = {pid: person_timeline(p) for pid, p in leaders.items()}
@@ -245,7 +218,7 @@ class Simulator:
 
         # RGB: shaded colour and the id buffer used for visibility
         mesh = concatenate([self.static, people_mesh])
-        hits = self._render(people_mesh, people_scene, self.rgb_camera, rgb_pose)
+        hits = self._render(people_scene, self.rgb_camera, rgb_pose)
         clean = shade(mesh, hits, self.light, sc.room.floor_tile)
         ids = object_ids(mesh, hits)
         gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s) * s.illumination
@@ -255,13 +228,13 @@ class Simulator:
         # depth: ideal z from the depth camera, then the sensor model
         # Rays go through the published (decimated) camera's pixel centres, so the
         # image agrees with its CameraInfo; edges are found on the published grid.
-        dh = self._render(people_mesh, people_scene, self.depth_camera, depth_pose)
+        dh = self._render(people_scene, self.depth_camera, depth_pose)
         edges = depth_edges(dh.depth, s.edge_jump)
         tri = dh.triangle
         hit = tri >= 0
         safe = np.where(hit, tri, 0)
         albedo = mesh.colours[safe]
-        luminance = albedo @ np.array([0.299, 0.587, 0.114])
+        luminance = albedo[..., 0] * 0.299 + albedo[..., 1] * 0.587 + albedo[..., 2] * 0.114
         material = mesh.materials[safe]
         dark = hit & (luminance < s.dark_level) & (material != MAT_SKIN)
         shiny = hit & (material == MAT_SHINY)
@@ -271,7 +244,12 @@ class Simulator:
             projector = depth_pose.transform_points(np.array([[s.baseline_m, 0.0, 0.0]]))[0]
             seen = np.flatnonzero(hit)
             points = dh.points().reshape(-1, 3)[seen]
-            shadow = occluded_towards([self._static_scene, people_scene], points, projector)
+            shadow = occluded_towards(
+                [self._static_scene, people_scene],
+                points,
+                projector,
+                depth_pose.rotation_matrix(),
+            )
             dropout.flat[seen[shadow]] = 1.0
         depth = noisy_depth(
             dh.depth,
@@ -289,24 +267,21 @@ class Simulator:
             gt = [replace(o, visibility=1.0, ignore=False) for o in gt]
         return SimFrame(index, stamp, t, rgb, depth, ids, base_true, base_odom, rgb_pose, gt)
 
-    def _render(
-        self,
-        people: Mesh,
-        people_scene: o3d.t.geometry.RaycastingScene,
-        camera: CameraModel,
-        pose: Pose,
-    ) -> Hits:
+    def _render(self, people: Scene, camera: CameraModel, pose: Pose) -> Hits:
         """Hits of static scene + people: the static part is cached while the camera stands.
 
         The cache is keyed by the whole camera model, so two cameras that share a frame id
         but differ in size or intrinsics never get each other's hits.
         """
-        base = self._static_hits.get(camera)
-        if base is None or base[0] != pose:
-            base = (pose, render_hits(self._static_scene, camera, pose))
-            self._static_hits[camera] = base
-        window = people_window(people, camera, pose)
-        return overlay_hits(base[1], people_scene, window, self.static.n_triangles)
+        base = self._static_casts.get(camera)
+        if base is None or base.pose != pose:
+            base = CameraCast(camera, pose)
+            base.cast(self._static_scene)
+            self._static_casts[camera] = base
+        cast = base.copy()
+        cast.cast(people, self._static_scene.n_triangles)
+        normals = np.concatenate([self._static_scene.face_normals, people.face_normals])
+        return cast.hits(normals)
 
     def scene_view(self, index: int, stream: int) -> SceneView:
         """Frame ``index`` for a rig sensor: its stamp and a renderer of the same scene.
@@ -320,7 +295,7 @@ class Simulator:
         _, people_mesh, people_scene = self._people
 
         def render(camera: CameraModel, pose: Pose) -> Hits:
-            return self._render(people_mesh, people_scene, camera, pose)
+            return self._render(people_scene, camera, pose)
 
         ids_all = np.concatenate([self.static.object_ids, people_mesh.object_ids])
         mats_all = np.concatenate([self.static.materials, people_mesh.materials])

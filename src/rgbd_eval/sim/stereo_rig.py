@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
 
+from rgbd_eval import exact
 from rgbd_eval.sim import rig
 from rgbd_eval.sim.meshes import rotation_y
 from rgbd_eval.sim.rig_sensors import (
@@ -99,7 +100,7 @@ class StereoPair:
 
     def __init__(self, config: StereoPairConfig, world_frame: str) -> None:
         self.cfg = c = config
-        fx = (c.width / 2.0) / math.tan(math.radians(c.hfov_deg) / 2.0)
+        fx = (c.width / 2.0) / exact.tan(math.radians(c.hfov_deg) / 2.0)
         cx, cy = (c.width - 1) / 2.0, (c.height - 1) / 2.0
         dist = (0.0,) * 5
         self.left = CameraModel(c.width, c.height, fx, fx, cx, cy, dist, f"{c.name}_left_optical")
@@ -133,7 +134,7 @@ class StereoPair:
         tex = surface_texture(pts, c.texture_scale_m, c.texture_seed)
         img[hit] *= (1.0 - c.texture_contrast + 2.0 * c.texture_contrast * tex)[:, None]
         if c.noise_std > 0:
-            img += view.rng.normal(0.0, c.noise_std, img.shape).astype(np.float32)
+            img += (exact.standard_normal(view.rng, img.shape) * c.noise_std).astype(np.float32)
         out: NDArray[np.uint8] = np.clip(img + 0.5, 0, 255).astype(np.uint8)
         return out
 
@@ -179,7 +180,7 @@ def with_stereo_rig(scenario: Scenario, width: int = 512, height: int = 384) -> 
     path and room are unchanged; the name gains ``_stereo``.
     """
     pair = StereoPairConfig(name=STEREO_NAME, width=width, height=height)
-    half_h = math.atan(math.tan(math.radians(pair.hfov_deg) / 2.0) * height / width)
+    half_h = exact.atan(exact.tan(math.radians(pair.hfov_deg) / 2.0) * height / width)
     data = scenario.model_dump(mode="json")
     data["name"] = f"{scenario.name}_stereo"
     data["sensor"].update(

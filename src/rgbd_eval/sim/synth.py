@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
 
+from rgbd_eval import __version__
 from rgbd_eval.config import data_home
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
@@ -71,6 +72,33 @@ def container_for(out_path: Path | str) -> SynthContainer:
     raise ValueError(f"out_path={str(out_path)!r} must end in .bag or .mcap")
 
 
+#: Bumped whenever rendering changes the bytes on purpose (tests/sim/test_determinism.py pins
+#: them): two recordings of the same provenance must then be the same bytes.
+RENDERER_VERSION = 2
+
+
+def provenance(
+    sim: Simulator, frames: int, container: SynthContainer, closed_loop: str | None = None
+) -> dict[str, object]:
+    """The provenance record of a recording (:mod:`rgbd_eval.io.provenance`).
+
+    ``closed_loop`` identifies what drove the robot when the path is not the scenario's.
+    """
+    sc = sim.scenario
+    return {
+        "generator": "rgbd-eval synth",
+        "tool_version": __version__,
+        "renderer_version": RENDERER_VERSION,
+        "scenario": sc.name,
+        "scenario_sha256": sc.digest(),
+        "scenario_file_sha256": sc.source_sha256,
+        "seed": sim.seed,
+        "frames": frames,
+        "container": container,
+        "closed_loop": closed_loop,
+    }
+
+
 def write_static(w: RecordingWriter, sim: Simulator, sensors: Sequence[RigSensor]) -> None:
     """The static transforms of the robot's cameras and of the rig's sensors."""
     first = sim.scenario.stamp_ns(0)
@@ -123,6 +151,7 @@ def synthesize(
         out, container=kind, options=stream_options(scenario), overwrite=overwrite
     ) as w:
         extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
+        w.write_provenance(scenario.stamp_ns(0), provenance(sim, total, kind))
         write_static(w, sim, extra)
         for f in sim.frames(list(range(total))):
             write_frame(w, sim, f)

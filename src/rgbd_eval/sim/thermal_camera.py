@@ -24,8 +24,8 @@ from typing import TYPE_CHECKING, Literal
 import numpy as np
 from numpy.typing import NDArray
 from pydantic import Field
-from scipy import ndimage
 
+from rgbd_eval import exact
 from rgbd_eval.sim.meshes import MAT_FLOOR, MAT_SKIN
 from rgbd_eval.sim.rig_sensors import (
     RigSensorConfig,
@@ -140,9 +140,7 @@ class ThermalCamera:
         if c.limb_contrast > 0.0:
             n = hits.face_normals.astype(np.float64)
             d = hits.directions.astype(np.float64)
-            cos = np.abs(np.einsum("ijk,ijk->ij", n, d)) / np.maximum(
-                np.linalg.norm(n, axis=2) * np.linalg.norm(d, axis=2), 1e-9
-            )
+            cos = np.abs(exact.dot(n, d)) / np.maximum(exact.norm(n) * exact.norm(d), 1e-9)
             keep = 1.0 - c.limb_contrast * (1.0 - cos)
             t = np.where(ids >= 0, c.ambient_c + (t - c.ambient_c) * keep, t)
         return t
@@ -152,9 +150,9 @@ class ThermalCamera:
         t = self.temperatures(view)
         c = self.cfg
         if c.blur_px > 0.0:
-            t = ndimage.gaussian_filter(t, c.blur_px, mode="nearest")
+            t = exact.gaussian_filter(t, c.blur_px)
         # always draw the noise so the stream stays aligned whatever netd_k is
-        t = t + view.rng.standard_normal(t.shape) * c.netd_k
+        t = t + exact.standard_normal(view.rng, t.shape) * c.netd_k
         return celsius_to_counts(t)
 
 

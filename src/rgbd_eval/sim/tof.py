@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.sensor import depth_edges
@@ -44,14 +45,16 @@ def radial_position(camera: CameraModel) -> F32:
     v = (np.arange(camera.height, dtype=np.float32) - np.float32(camera.cy)) / np.float32(
         camera.height / 2.0
     )
-    rho2: F32 = ((u[None, :] ** 2 + v[:, None] ** 2) / np.float32(2.0)).astype(np.float32)
+    rho2: F32 = ((u[None, :] * u[None, :] + v[:, None] * v[:, None]) / np.float32(2.0)).astype(
+        np.float32
+    )
     return rho2
 
 
 def tof_sigma(z: F64, rho2: F32, cfg: StaticDepthConfig) -> F64:
     """Noise std per pixel: the sensor's own (depth and off-centre) and the added noise."""
     own = cfg.noise_k * z * z * (1.0 + cfg.off_centre_gain * rho2)
-    sigma: F64 = np.sqrt(own * own + cfg.extra_noise_m**2)
+    sigma: F64 = np.sqrt(own * own + cfg.extra_noise_m * cfg.extra_noise_m)
     return sigma
 
 
@@ -68,7 +71,7 @@ def tof_depth(ideal: NDArray[np.floating], cfg: StaticDepthConfig, rng: np.rando
         rho2 = (
             radial_position(camera) if cfg.off_centre_gain > 0.0 else np.zeros(z.shape, np.float32)
         )
-        z = z + rng.normal(0.0, 1.0, z.shape) * tof_sigma(np.where(valid, z, 0.0), rho2, cfg)
+        z = z + exact.standard_normal(rng, z.shape) * tof_sigma(np.where(valid, z, 0.0), rho2, cfg)
     keep = valid & (z >= cfg.min_range_m) & (z <= cfg.max_range_m)
     if cfg.edge_dropout > 0.0 or cfg.random_dropout > 0.0:
         edges = depth_edges(np.asarray(ideal, dtype=np.float32), cfg.edge_jump)

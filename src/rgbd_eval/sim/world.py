@@ -11,6 +11,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from rgbd_eval import exact
 from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.meshes import (
     F64,
@@ -68,7 +69,7 @@ def obstacle_mesh(ob: Obstacle, object_id: int, b: MeshBuilder) -> None:
     o = np.array([ob.x, ob.y, ob.z])
 
     def at(dx: float, dy: float, dz: float) -> F64:
-        out: F64 = o + R @ np.array([dx, dy, dz])
+        out: F64 = o + exact.matmul(R, np.array([[dx], [dy], [dz]]))[:, 0]
         return out
 
     kind = ob.kind
@@ -107,22 +108,28 @@ def obstacle_mesh(ob: Obstacle, object_id: int, b: MeshBuilder) -> None:
         dark = _f(ob.rgb, 0.8)
         for k in range(3):
             a = 2.0 * math.pi * k / 3.0
-            foot = at(0.17 * math.cos(a), 0.17 * math.sin(a), 0.02)
-            b.box(foot, (0.34, 0.04, 0.04), R @ rotation_z(a), dark, object_id, mat)
+            foot = at(0.17 * exact.cos(a), 0.17 * exact.sin(a), 0.02)
+            b.box(foot, (0.34, 0.04, 0.04), exact.matmul(R, rotation_z(a)), dark, object_id, mat)
         b.cylinder(o, 0.022, sz, col, object_id, mat)
         coats = ((70, 70, 85), (120, 90, 60), (40, 60, 45))
         for k, coat in enumerate(coats):
             a = 2.0 * math.pi * k / 3.0 + 0.4
-            ca, sa = math.cos(a), math.sin(a)
+            ca, sa = exact.cos(a), exact.sin(a)
             b.box(
                 at(0.08 * ca, 0.08 * sa, sz - 0.06),
                 (0.16, 0.02, 0.02),
-                R @ rotation_z(a),
+                exact.matmul(R, rotation_z(a)),
                 col,
                 object_id,
             )
             centre = at(0.13 * ca, 0.13 * sa, sz - 0.36)
-            b.sphere(centre, (0.1, 0.16 + 0.03 * k, 0.3), R @ rotation_z(a), _f(coat), object_id)
+            b.sphere(
+                centre,
+                (0.1, 0.16 + 0.03 * k, 0.3),
+                exact.matmul(R, rotation_z(a)),
+                _f(coat),
+                object_id,
+            )
         b.sphere(at(0, 0, sz), (0.05, 0.05, 0.03), R, col, object_id)
     elif kind is ObstacleKind.PLANT:
         # a pot and many small leaf clusters in a wide, irregular crown
@@ -133,16 +140,21 @@ def obstacle_mesh(ob: Obstacle, object_id: int, b: MeshBuilder) -> None:
         rng = np.random.default_rng(seed)
         n = 40
         for _ in range(n):
-            f = rng.uniform(0.1, 1.0) ** 0.7  # denser towards the top: a bushy crown
+            f = exact.power(
+                float(rng.uniform(0.1, 1.0)), 0.7
+            )  # denser towards the top: a bushy crown
             zc = pot_h + f * (sz - pot_h - 0.08)
             # leaves (up to 0.14 m) stay inside the declared footprint
-            r = max(sx / 2 - 0.14, 0.05) * (0.5 + 0.5 * math.sin(math.pi * min(f, 0.9)))
+            r = max(sx / 2 - 0.14, 0.05) * (0.5 + 0.5 * exact.sin(math.pi * min(f, 0.9)))
             ang = rng.uniform(0.0, 2.0 * math.pi)
             rad = r * math.sqrt(rng.uniform(0.2, 1.0))
             size = tuple(float(v) for v in rng.uniform(0.06, 0.14, 3))
-            leaf_R = R @ rotation_z(rng.uniform(0, math.pi)) @ rotation_x(rng.uniform(-1.0, 1.0))
+            leaf_R = exact.matmul(
+                exact.matmul(R, rotation_z(float(rng.uniform(0, math.pi)))),
+                rotation_x(float(rng.uniform(-1.0, 1.0))),
+            )
             shade = 0.6 + 0.6 * rng.random()
-            centre = at(rad * math.cos(ang), rad * math.sin(ang), zc)
+            centre = at(rad * exact.cos(ang), rad * exact.sin(ang), zc)
             b.sphere(centre, (size[0], size[1], size[2]), leaf_R, _f(ob.rgb, shade), object_id)
     elif kind is ObstacleKind.CABINET:
         b.box(at(0, 0, sz / 2), (sx, sy, sz), R, col, object_id, mat)

@@ -1,0 +1,215 @@
+"""Rendered recordings are the same bytes on every x86-64 CPU (rgbd_eval.exact explains why
+they were not).
+
+Two guards: the digests of a few rendered frames are pinned, so a machine that renders
+other bytes fails here rather than at the CI gate; and the simulator's source may not call
+the operations whose last bits depend on the CPU (BLAS products, libm and numpy
+transcendentals, numpy's normal sampler, Embree). ``tools/cpu_independence.py`` renders
+under other CPUs (other BLAS kernels, numpy without SIMD, qemu's Haswell and SandyBridge).
+"""
+
+from __future__ import annotations
+
+import ast
+import hashlib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rgbd_eval
+from rgbd_eval.sim.scenario import load_scenario, scenarios_dir
+from rgbd_eval.sim.simulate import Simulator
+from rgbd_eval.sim.synth import RENDERER_VERSION
+from rgbd_eval.sim.tof import TofRig
+
+SRC = Path(rgbd_eval.__file__).parent
+
+
+def _frame_digest(scenario: str, index: int) -> str:
+    sim = Simulator(load_scenario(scenarios_dir() / scenario))
+    f = sim.frame(index)
+    h = hashlib.sha256()
+    for a in (f.rgb, f.depth, f.ids, np.asarray(sim.odom_poses[index])):
+        h.update(np.ascontiguousarray(a).tobytes())
+    for g in f.ground_truth:
+        h.update(repr((g.object_id, g.box2d, g.world_xyz, g.visibility, g.ignore)).encode())
+    for k, cfg in enumerate(sim.scenario.rig):  # the rig's sensors render from the same scene
+        from rgbd_eval.sim.rig_sensors import make_rig_sensor
+
+        sensor = make_rig_sensor(cfg, "odom")
+        view = sim.scene_view(index, k)
+        if hasattr(sensor, "render_pair"):
+            for img in sensor.render_pair(view):
+                h.update(img.tobytes())
+        elif hasattr(sensor, "render_counts"):
+            h.update(sensor.render_counts(view).tobytes())
+    return h.hexdigest()
+
+
+#: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 2.
+PINNED = {
+    ("demo.yaml", 0): "10591af574ec0323bff385440ad5c946c2db5bc7c41030d9046d3fc15203c494",
+    ("demo.yaml", 100): "b0474c5f7894580e99d113ebb062c9689fbb026ffa96d8238f3a7ffe846e8db4",
+    ("moving_complex.yaml", 40): "45558d43e835976985942f8e184a3d5751b2389bdcadd7a33b4d6395d3f7954e",
+    (
+        "satake2009_crossing.yaml",
+        3,
+    ): "b15580ed5dbaa890cc0949d13ab0cc8599f102ced664ce504b0fb9fffed0c5ca",
+    (
+        "cielniak2010/thermal_crossings.yaml",
+        3,
+    ): "b472c49cee02c3f4824308ed9dafe4026fefd85847d2c758e32716846b03ca35",
+}
+
+
+@pytest.mark.parametrize(("scenario", "index"), sorted(PINNED))
+def test_rendered_frames_are_the_pinned_bytes(scenario: str, index: int) -> None:
+    got = _frame_digest(scenario, index)
+    assert got == PINNED[(scenario, index)], (
+        f"{scenario} frame {index} rendered to other bytes ({got}). If the renderer was changed "
+        f"on purpose, bump RENDERER_VERSION ({RENDERER_VERSION}) in rgbd_eval/sim/synth.py and "
+        "update PINNED; otherwise rendering depends on this machine (see rgbd_eval/exact.py)."
+    )
+
+
+def test_static_depth_cameras_are_the_pinned_bytes() -> None:
+    rig = TofRig(load_scenario(scenarios_dir() / "dmtbs" / "scene1.yaml"))
+    h = hashlib.sha256()
+    for image in rig.frame(3).images:
+        h.update(image.depth.tobytes())
+    assert h.hexdigest() == "9cf52a7710803b840ff45a1460379e902c32f1a875c957b9a462bd895183a62c"
+
+
+# ----------------------------------------------------------------------------- the lint
+
+#: Calls whose result depends on the CPU (module attribute -> names).
+_FORBIDDEN_CALLS = {
+    "np": {
+        "sin",
+        "cos",
+        "tan",
+        "arcsin",
+        "arccos",
+        "arctan",
+        "arctan2",
+        "sinh",
+        "cosh",
+        "tanh",
+        "exp",
+        "exp2",
+        "expm1",
+        "log",
+        "log2",
+        "log10",
+        "log1p",
+        "power",
+        "float_power",
+        "hypot",
+        "cbrt",
+        "dot",
+        "vdot",
+        "matmul",
+        "einsum",
+        "tensordot",
+        "inner",
+        "cross",
+    },
+    "math": {
+        "sin",
+        "cos",
+        "tan",
+        "asin",
+        "acos",
+        "atan",
+        "atan2",
+        "sinh",
+        "cosh",
+        "tanh",
+        "exp",
+        "expm1",
+        "log",
+        "log2",
+        "log10",
+        "log1p",
+        "pow",
+        "hypot",
+        "cbrt",
+        "erf",
+        "gamma",
+    },
+    "linalg": {"norm", "inv", "det", "solve", "eig", "eigh", "svd", "cholesky", "qr"},
+    "ndimage": {"gaussian_filter", "gaussian_filter1d"},
+}
+#: numpy Generator methods that call libm (their tails, or their whole transform).
+_FORBIDDEN_SAMPLERS = {
+    "normal",
+    "standard_normal",
+    "exponential",
+    "standard_exponential",
+    "gamma",
+    "poisson",
+    "lognormal",
+    "beta",
+    "binomial",
+    "chisquare",
+    "laplace",
+    "logistic",
+    "vonmises",
+    "weibull",
+}
+
+
+def _violations(path: Path) -> list[str]:
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    out = []
+    for node in ast.walk(tree):
+        where = f"{path.relative_to(SRC)}:{getattr(node, 'lineno', 0)}"
+        if isinstance(node, ast.BinOp | ast.AugAssign) and isinstance(node.op, ast.MatMult):
+            out.append(f"{where}: '@' (BLAS)")
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Pow):
+            ints = all(
+                isinstance(v, ast.Constant) and isinstance(v.value, int)
+                for v in (node.left, node.right)
+            )
+            if not ints:
+                out.append(f"{where}: '**' (libm pow)")
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            name, owner = node.func.attr, node.func.value
+            owner_name = (
+                owner.id
+                if isinstance(owner, ast.Name)
+                else owner.attr
+                if isinstance(owner, ast.Attribute)
+                else ""
+            )
+            if name in _FORBIDDEN_CALLS.get(owner_name, set()):
+                out.append(f"{where}: {owner_name}.{name}")
+            elif name in _FORBIDDEN_SAMPLERS and owner_name not in ("exact", "np", "math"):
+                out.append(f"{where}: .{name}() (numpy's sampler calls libm)")
+        if isinstance(node, ast.Attribute) and node.attr in ("RaycastingScene", "o3d"):
+            out.append(f"{where}: Open3D ray casting (Embree)")
+        if isinstance(node, ast.Name) and node.id == "o3d":
+            out.append(f"{where}: Open3D ray casting (Embree)")
+    return out
+
+
+def test_the_simulator_calls_nothing_whose_bits_depend_on_the_cpu() -> None:
+    files = [*sorted((SRC / "sim").rglob("*.py")), SRC / "types.py"]
+    bad = [v for f in files if f.name != "preview.py" for v in _violations(f)]
+    assert bad == [], "use rgbd_eval.exact instead:\n" + "\n".join(bad)
+
+
+def test_the_lint_finds_what_it_forbids(tmp_path: Path) -> None:
+    bad = SRC / "sim" / "_lint_probe.py"
+    try:
+        bad.write_text(
+            "import math\nimport numpy as np\n"
+            "def f(a, b, rng):\n"
+            "    return a @ b, np.sin(a), math.exp(1.0), rng.normal(0, 1), a ** 0.5, np.linalg.norm(a)\n",
+            encoding="utf-8",
+        )
+        found = _violations(bad)
+    finally:
+        bad.unlink()
+    assert len(found) == 6, found
