@@ -215,7 +215,7 @@ class Lens:
         r2 = x * x + y * y
         if self.fisheye:
             r = np.sqrt(r2)
-            theta = np.arctan(r)
+            theta = exact.atan(r)
             f = self._held(theta * theta)[0]
             with np.errstate(divide="ignore", invalid="ignore"):
                 scale = np.where(r > 1e-8, theta * f / r, 1.0)
@@ -248,7 +248,7 @@ class Lens:
         s = self._radius(d)
         with np.errstate(divide="ignore", invalid="ignore"):
             # A fisheye pixel 90 deg or more off the axis has no ray with z > 0: NaN.
-            r = np.where(s < np.pi / 2, np.tan(s), np.nan) if self.fisheye else s
+            r = np.where(s < np.pi / 2, exact.tan(s), np.nan) if self.fisheye else s
             scale = np.where(d > 1e-8, r / d, 1.0)
         x, y = xd * scale, yd * scale
         if self.fisheye or not any(self.coefficients[2:4]):
