@@ -47,6 +47,7 @@ from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig
 from rgbd_eval.sim.synth import (
+    OWNER,
     SynthContainer,
     ground_truth_path,
     stream_options,
@@ -320,9 +321,7 @@ def follow(
         sensors = [make_rig_sensor(s, rig.WORLD_FRAME) for s in scenario.rig]
         if out_path is not None:
             options = stream_options(scenario)
-            writer = stack.enter_context(
-                RecordingWriter(out_path, container, options, overwrite=True)
-            )
+            writer = stack.enter_context(RecordingWriter(out_path, container, options, owner=OWNER))
             write_static(writer, sim, sensors)
         for i in range(n):
             c0 = time.process_time()
@@ -366,7 +365,7 @@ def follow(
             if progress is not None:
                 progress(i + 1, n)
     if out_path is not None:
-        write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame])
+        write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame], OWNER)
     summary = _summary(scenario, sim.seed, target, steps, c)
     return FollowResult(tuple(steps), summary, tuple(all_tracks), tuple(truth), cpu)
 
@@ -454,8 +453,9 @@ def follow_paths(out_path: Path) -> tuple[Path, Path]:
 
 
 def write_follow(result: FollowResult, out_path: Path) -> tuple[Path, Path]:
-    """Write the per-frame CSV and the summary JSON beside ``out_path`` (atomically)."""
+    """Write the per-frame CSV and the summary JSON beside ``out_path`` (atomically; each
+    replaces only a file ``synth`` wrote)."""
     csv_path, json_path = follow_paths(out_path)
-    write_text(csv_path, steps_csv(result.steps))
-    write_json(json_path, {"schema_version": 1, **asdict(result.summary)})
+    write_text(csv_path, steps_csv(result.steps), OWNER)
+    write_json(json_path, {"schema_version": 1, **asdict(result.summary)}, OWNER)
     return csv_path, json_path
