@@ -132,6 +132,53 @@ def test_damaged_entries_are_misses(tmp_path: Path, mangle: object, reason: str)
         assert cache.load(KEY) is None
 
 
+@pytest.mark.parametrize(
+    ("make", "reason"),
+    [
+        (os.mkfifo, "named pipe"),  # opening it would block for ever
+        (lambda p: p.symlink_to("/dev/zero"), "device"),  # reading it would never end
+        (lambda p: p.mkdir(), "folder"),
+    ],
+)
+def test_an_entry_that_is_not_a_regular_file_is_never_opened_nor_replaced(
+    tmp_path: Path, make: object, reason: str
+) -> None:
+    cache = DetectionCache(tmp_path)
+    path = cache.path(KEY)
+    path.parent.mkdir(parents=True)
+    make(path)  # type: ignore[operator]
+    with pytest.warns(UserWarning, match=f"{reason}.*recomputing .it is not replaced: remove it"):
+        assert cache.load(KEY) is None
+    before = os.lstat(path)
+    cache.store(KEY, sample())  # left as it is: not a file we wrote
+    after = os.lstat(path)
+    assert (before.st_mode, before.st_ino) == (after.st_mode, after.st_ino)
+    assert not cache.has(KEY)
+    assert [p.name for p in path.parent.iterdir()] == [path.name]  # no temporary file left
+
+
+def test_an_entry_larger_than_the_bound_is_not_read(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cache = DetectionCache(tmp_path)
+    cache.store(KEY, sample())
+    monkeypatch.setattr("rgbd_eval.cache.MAX_ENTRY_BYTES", 100)
+    with pytest.warns(UserWarning, match="more than the 100-byte limit, recomputing$"):
+        assert cache.load(KEY) is None
+
+
+def test_a_digest_memo_that_is_a_named_pipe_is_not_opened(tmp_path: Path) -> None:
+    recording = tmp_path / "rec.mcap"
+    recording.write_bytes(b"abc")
+    cache = DetectionCache(tmp_path / "cache")
+    memo = cache._memo(recording)
+    memo.parent.mkdir(parents=True)
+    os.mkfifo(memo)
+    assert cache.known_digest(recording) is None
+    assert cache.digest(recording) == hashlib.sha256(b"abc").hexdigest()
+    assert os.path.exists(memo) and not memo.is_file()  # left alone
+
+
 def test_checksummed_garbage_and_foreign_keys_are_misses(tmp_path: Path) -> None:
     cache = DetectionCache(tmp_path)
     blob = encode(KEY, sample())

@@ -72,3 +72,23 @@ def test_every_error_survives_the_trip_back_from_a_worker() -> None:
         assert type(back) is type(err)
         assert (str(back), back.exit_code, back.__dict__) == (str(err), err.exit_code, err.__dict__)
     assert pickle.loads(pickle.dumps(made[0])).topic == "/rgb"
+
+
+@pytest.mark.parametrize(
+    ("address", "reason"),
+    [("ucx://127.0.0.1:1", "cannot connect over ucx://"), ("tls://127.0.0.1:1", "certificates")],
+)
+def test_a_transport_dask_cannot_use_here_is_refused_before_connecting(
+    address: str, reason: str
+) -> None:
+    # Dask fails on these only inside its client, then waits 40 s to close it (issue 28).
+    from distributed.comm.registry import get_backend
+
+    if address.startswith("ucx"):
+        try:
+            get_backend("ucx").get_connector()
+            pytest.skip("this installation has a UCX package")
+        except TypeError:
+            pass
+    with pytest.raises(ClusterError, match=reason):
+        parse_cluster(address)

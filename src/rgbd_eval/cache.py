@@ -12,7 +12,9 @@ sha256 of the payload in hex, a newline, then the payload, an uncompressed
 beside the target and renamed into place, so concurrent writers of the same key
 (two workers, two machines on a network filesystem) leave one complete entry.
 An entry whose checksum, layout or key does not match is a miss: it is
-recomputed and overwritten, with a warning; it is never trusted.
+recomputed and overwritten, with a warning; it is never trusted. Only regular files
+are read, no larger than :data:`MAX_ENTRY_BYTES`, and only regular files are replaced:
+a named pipe or a link to a device in the cache is a miss with a warning, left alone.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ from numpy.typing import NDArray
 from rgbd_eval import __version__
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import CacheError
+from rgbd_eval.files import read_bytes
 from rgbd_eval.pipeline import SequenceDetections
 from rgbd_eval.report import file_digest
 from rgbd_eval.types import Box2D, Box3D, Detection
@@ -45,6 +48,9 @@ from rgbd_eval.types import Box2D, Box3D, Detection
 CACHE_FORMAT = 3  # 3: checksummed npz entries (1 and 2 were pickles)
 _MAGIC = b"rgbd-eval detections 2\n"
 _DIGEST_LEN = 64  # hex sha256
+#: Largest entry read (4 GiB): a sequence's detections with appearance vectors take
+#: tens of MB; a larger file is not one we wrote, and is not loaded into memory.
+MAX_ENTRY_BYTES = 4 << 30
 
 
 class CacheWarning(UserWarning):
@@ -247,6 +253,16 @@ def _stat_identity(path: Path) -> list[list[Any]]:
     return out
 
 
+def _replaceable(path: Path) -> bool:
+    """Whether ``path`` is absent or a regular file (not a link, pipe, device or folder)."""
+    try:
+        return stat.S_ISREG(os.lstat(path).st_mode)
+    except (FileNotFoundError, NotADirectoryError):  # absent (writing it may still fail)
+        return True
+    except OSError:
+        return False
+
+
 class DetectionCache:
     """Load and store :class:`SequenceDetections` by key under ``root``."""
 
@@ -262,11 +278,14 @@ class DetectionCache:
 
     @staticmethod
     def _read_memo(memo: Path) -> str | None:
-        """The digest a memo holds, or None when it is missing or does not hold one."""
-        with contextlib.suppress(OSError, UnicodeDecodeError):
-            text = memo.read_text(encoding="ascii").strip()
-            if len(text) == _DIGEST_LEN and all(c in "0123456789abcdef" for c in text):
-                return text
+        """The digest a memo holds, or None when it is missing or does not hold one (a memo
+        that is not a small regular file is not opened)."""
+        with contextlib.suppress(CacheError, UnicodeDecodeError):
+            text = read_bytes(memo, lambda m: CacheError(memo, m), "memo", 256).decode("ascii")
+            if len(text.strip()) == _DIGEST_LEN and all(
+                c in "0123456789abcdef" for c in text.strip()
+            ):
+                return text.strip()
         return None
 
     def known_digest(self, recording: Path) -> str | None:
@@ -289,6 +308,8 @@ class DetectionCache:
         if known is not None:
             return known
         digest = file_digest(recording)
+        if not _replaceable(memo):
+            return digest
         tmp = memo.with_name(f".{memo.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
         try:  # a memo that cannot be written costs a re-hash next time, nothing else
             memo.parent.mkdir(parents=True, exist_ok=True)
@@ -308,15 +329,23 @@ class DetectionCache:
         return self.path(key).is_file()
 
     def load(self, key: str) -> SequenceDetections | None:
-        """The entry of ``key``; None when absent or rejected (a rejection warns)."""
+        """The entry of ``key``; None when absent or rejected (a rejection warns).
+
+        Only a regular file of at most :data:`MAX_ENTRY_BYTES` is opened: a named pipe
+        would block, a link to ``/dev/zero`` never end.
+        """
         path = self.path(key)
-        try:
-            blob = path.read_bytes()
-        except FileNotFoundError:
+        if not os.path.lexists(path):
             return None
-        except OSError as err:
+        try:
+            blob = read_bytes(path, lambda m: CacheError(path, m), "it", MAX_ENTRY_BYTES)
+        except CacheError as err:
+            if not os.path.lexists(path):  # removed meanwhile
+                return None
+            kept = "" if _replaceable(path) else " (it is not replaced: remove it)"
             warnings.warn(
-                f"detection cache entry {path}: unreadable ({err.strerror}), recomputing",
+                f"detection cache entry {path}: {str(err).removeprefix(f'{path}: ')}, "
+                f"recomputing{kept}",
                 CacheWarning,
                 stacklevel=2,
             )
@@ -330,8 +359,11 @@ class DetectionCache:
             return None
 
     def store(self, key: str, detections: SequenceDetections) -> None:
-        """Write the entry of ``key`` atomically (unique temporary file, then rename)."""
+        """Write the entry of ``key`` atomically (unique temporary file, then rename); an
+        entry path that holds anything but a regular file is left as it is (not stored)."""
         path = self.path(key)
+        if not _replaceable(path):
+            return
         tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}-{uuid.uuid4().hex[:8]}")
         blob = encode(key, detections)
         try:

@@ -18,7 +18,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
-from rgbd_eval.errors import ClusterError, ConfigError
+from rgbd_eval.errors import ClusterError, ConfigError, RgbdEvalError
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -57,6 +57,7 @@ def parse_cluster(spec: str | None, tasks: int | None = None) -> ClusterSpec:
         scheme, _, rest = text.partition("://")
         if scheme not in ("tcp", "tls", "ucx", "ws", "wss") or not rest:
             raise ConfigError(f"--cluster {text!r}: expected local, local:N or tcp://host:port")
+        check_transport(text)
         return ClusterSpec(text, 0)
     name, sep, count = text.partition(":")
     if name != "local":
@@ -73,6 +74,35 @@ def parse_cluster(spec: str | None, tasks: int | None = None) -> ClusterSpec:
     return ClusterSpec(None, workers)
 
 
+def check_transport(address: str) -> None:
+    """ClusterError unless Dask can open a connection of ``address``'s kind from here.
+
+    Checked before any work, without connecting: ``ucx://`` needs a UCX package this
+    installation may lack, ``tls://`` and ``wss://`` need certificates in Dask's
+    configuration. (Dask fails on either only inside its client, and then waits 40 s to
+    close the half-made client.)
+    """
+    from distributed.comm.registry import get_backend
+    from distributed.security import Security
+
+    scheme = address.partition("://")[0]
+    try:
+        get_backend(scheme).get_connector()
+    except (ValueError, TypeError, ImportError, RuntimeError) as err:
+        raise ClusterError(
+            f"--cluster {address}: this installation of Dask cannot connect over {scheme}:// "
+            f"({' '.join(str(err).split())})"
+        ) from err
+    if (
+        scheme in ("tls", "wss")
+        and Security().get_connection_args("client").get("ssl_context") is None
+    ):
+        raise ClusterError(
+            f"--cluster {address}: {scheme}:// needs TLS certificates in Dask's configuration "
+            "(distributed.comm.tls.ca-file, .client.cert and .client.key)"
+        )
+
+
 @contextmanager
 def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator[Client]:
     """A client of the cluster ``spec``; a local cluster is started and shut down with it.
@@ -83,9 +113,10 @@ def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator
     from distributed import Client
 
     if spec.address is not None:
+        check_transport(spec.address)
         try:
             client = Client(spec.address, timeout=timeout_s, set_as_default=False)
-        except (OSError, TimeoutError) as err:
+        except (OSError, TimeoutError, TypeError, ValueError) as err:
             raise ClusterError(f"cannot reach the scheduler at {spec.address}: {err}") from err
         try:
             client.wait_for_workers(1, timeout=timeout_s)
@@ -163,19 +194,42 @@ def map_ordered(
     progress: Callable[[int, int], None] | None = None,
 ) -> list[Any]:
     """``[func(*a) for a in args]`` on the cluster, in input order; ``progress(done, total)``
-    is called as tasks complete. The first failing task (in input order) re-raises its error."""
+    is called as tasks complete. The first failing task (in input order) re-raises its error.
+
+    The package's own errors come back as values (:class:`_Raised`): a task that raised
+    would have its worker log a "Compute Failed" block with a traceback on stderr, before
+    our one error line.
+    """
     from distributed import KilledWorker, as_completed
 
-    futures = [client.submit(func, *a, pure=False) for a in args]
+    futures = [client.submit(_returning_errors, func, *a, pure=False) for a in args]
     try:
         for done, _ in enumerate(as_completed(futures, loop=client.loop), start=1):
             if progress is not None:
                 progress(done, len(futures))
-        return [f.result() for f in futures]
+        results = [f.result() for f in futures]
     except KilledWorker as err:
         raise ClusterError(killed_worker_message(err)) from err
     finally:
         client.cancel(futures)
+    for result in results:
+        if isinstance(result, _Raised):
+            raise result.error
+    return results
+
+
+@dataclass(frozen=True)
+class _Raised:
+    """What a task of :func:`map_ordered` raised, returned to the client."""
+
+    error: RgbdEvalError
+
+
+def _returning_errors(func: Callable[..., Any], *args: Any) -> Any:
+    try:
+        return func(*args)
+    except RgbdEvalError as err:
+        return _Raised(err)
 
 
 def killed_worker_message(err: BaseException) -> str:

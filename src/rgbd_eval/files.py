@@ -28,13 +28,18 @@ MAX_TEXT_BYTES = 256 << 20
 MAX_YAML_VALUES = 100_000
 
 
-def _kind(mode: int) -> str:
+def file_kind(mode: int) -> str:
+    """What a non-regular file is, for messages: "a named pipe", "a device", ..."""
     if stat.S_ISFIFO(mode):
         return "a named pipe"
     if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
         return "a device"
     if stat.S_ISSOCK(mode):
         return "a socket"
+    if stat.S_ISLNK(mode):
+        return "a symbolic link"
+    if stat.S_ISDIR(mode):
+        return "a folder"
     return "not a regular file"
 
 
@@ -54,7 +59,7 @@ def check_input(
             return st
         raise error(f"cannot read {what} (it is a folder)")
     if not stat.S_ISREG(st.st_mode):
-        raise error(f"cannot read {what} (it is {_kind(st.st_mode)}, not a regular file)")
+        raise error(f"cannot read {what} (it is {file_kind(st.st_mode)}, not a regular file)")
     return st
 
 

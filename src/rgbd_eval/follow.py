@@ -50,6 +50,7 @@ from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig
 from rgbd_eval.sim.synth import (
+    OWNER,
     SynthContainer,
     ground_truth_path,
     provenance,
@@ -335,9 +336,7 @@ def follow(
         sensors = [make_rig_sensor(s, rig.WORLD_FRAME) for s in scenario.rig]
         if out_path is not None:
             options = stream_options(scenario)
-            writer = stack.enter_context(
-                RecordingWriter(out_path, container, options, overwrite=True)
-            )
+            writer = stack.enter_context(RecordingWriter(out_path, container, options, owner=OWNER))
             loop = json.dumps({"target": target, "config": config_to_dict(cfg)}, sort_keys=True)
             digest = hashlib.sha256(loop.encode("utf-8")).hexdigest()
             writer.write_provenance(scenario.stamp_ns(0), provenance(sim, n, container, digest))
@@ -384,7 +383,7 @@ def follow(
             if progress is not None:
                 progress(i + 1, n)
     if out_path is not None:
-        write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame])
+        write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame], OWNER)
     summary = _summary(scenario, sim.seed, target, steps, c)
     return FollowResult(tuple(steps), summary, tuple(all_tracks), tuple(truth), cpu)
 
@@ -475,8 +474,9 @@ def follow_paths(out_path: Path) -> tuple[Path, Path]:
 
 
 def write_follow(result: FollowResult, out_path: Path) -> tuple[Path, Path]:
-    """Write the per-frame CSV and the summary JSON beside ``out_path`` (atomically)."""
+    """Write the per-frame CSV and the summary JSON beside ``out_path`` (atomically; each
+    replaces only a file ``synth`` wrote)."""
     csv_path, json_path = follow_paths(out_path)
-    write_text(csv_path, steps_csv(result.steps))
-    write_json(json_path, {"schema_version": 1, **asdict(result.summary)})
+    write_text(csv_path, steps_csv(result.steps), OWNER)
+    write_json(json_path, {"schema_version": 1, **asdict(result.summary)}, OWNER)
     return csv_path, json_path

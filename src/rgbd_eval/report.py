@@ -353,7 +353,7 @@ def write_run(
 
     digests = [file_digest(Path(r.path)) for r in results]
     report = report_dict(results, config, digests)
-    folder = out if isinstance(out, OutputFolder) else OutputFolder(out, REPORT_FILE)
+    folder = out if isinstance(out, OutputFolder) else OutputFolder(out, REPORT_FILE, command="run")
     with folder:
         tmp = folder.staging
         for r in results:

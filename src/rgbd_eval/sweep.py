@@ -717,7 +717,13 @@ def run_sweep(
                     fresh = prepared[group].result()
                     cache.store(fresh.key, fresh.detections)
     finally:
-        client.cancel([*prepared.values(), *briefs.values(), *tracked.values()])
+        # Only the last tasks of each chain are cancelled (the scheduler then releases what
+        # they needed). Cancelling a prepare task would cancel its track tasks too, which
+        # no client holds, and trips an assertion in Dask's scheduler (a traceback on
+        # stderr after a successful client-mode sweep); the prepare futures are released.
+        client.cancel([*briefs.values(), *tracked.values()])
+        for future in prepared.values():
+            future.release()
     records, failures = [], []
     for (point, _, path), out in zip(units, outcomes, strict=True):
         if isinstance(out, _Failed):

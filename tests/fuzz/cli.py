@@ -2,17 +2,25 @@
 
 from __future__ import annotations
 
+import contextlib
+import os
+import resource
 import signal
+import subprocess
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+import rgbd_eval
 from rgbd_eval.cli.main import main
 
 #: Generous bound on one in-process command (the slowest case takes a few seconds).
 TIME_LIMIT_S = 120
+#: The package's folder on the path of a fresh interpreter: the same sources as in-process.
+SRC = Path(rgbd_eval.__file__).resolve().parents[1]
 
 
 class HungError(Exception):
@@ -32,6 +40,21 @@ class Outcome:
     @property
     def error_lines(self) -> list[str]:
         return [line for line in self.stderr.splitlines() if line.strip()]
+
+
+@contextlib.contextmanager
+def file_size_limit(limit: int | None) -> Iterator[None]:
+    """RLIMIT_FSIZE set to ``limit`` bytes meanwhile (None: unchanged): longer writes fail
+    with EFBIG, as on a full disk (Python ignores the SIGXFSZ that comes with it)."""
+    if limit is None:
+        yield
+        return
+    old = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (limit, old[1]))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, old)
 
 
 def run_cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> Outcome:
@@ -54,6 +77,31 @@ def run_cli(args: list[str], capsys: pytest.CaptureFixture[str]) -> Outcome:
     out = capsys.readouterr()
     code = exited.value.code
     return Outcome(code if isinstance(code, int) else 1, out.out, out.err)
+
+
+def run_isolated(args: list[str], cwd: Path, max_file_bytes: int | None = None) -> Outcome:
+    """``rgbd-eval ARGS`` in a fresh interpreter; a hang is killed after TIME_LIMIT_S (-9)."""
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+
+    def limit() -> None:
+        if max_file_bytes is not None:
+            hard = resource.getrlimit(resource.RLIMIT_FSIZE)[1]
+            resource.setrlimit(resource.RLIMIT_FSIZE, (max_file_bytes, hard))
+
+    try:
+        proc = subprocess.run(
+            [sys.executable, "-m", "rgbd_eval", *args],
+            cwd=cwd,
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=TIME_LIMIT_S,
+            preexec_fn=limit,
+        )
+    except subprocess.TimeoutExpired as err:
+        stderr = err.stderr.decode() if isinstance(err.stderr, bytes) else (err.stderr or "")
+        return Outcome(-9, "", stderr + f"\n(killed: no answer within {TIME_LIMIT_S} s)")
+    return Outcome(proc.returncode, proc.stdout, proc.stderr)
 
 
 def leftovers(root: Path) -> list[Path]:

@@ -10,6 +10,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import os
+import stat
 import struct
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
@@ -17,12 +18,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pytest
 
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.images import encode_depth_raw
 from rgbd_eval.io.messages import CAMERA_INFO_TYPE, IMAGE_TYPE
 from rgbd_eval.io.writer import DEPTH_INFO_TOPIC, Container, RecordingWriter
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, GroundTruthObject, Pose
+from tests.fuzz.cli import run_isolated
 from tests.io.conftest import (
     BASE_TO_CAMERA,
     DEPTH_CAM,
@@ -50,6 +53,12 @@ class Case:
     build: Callable[[Path], list[str]]  # writes inputs under the folder, returns CLI arguments
     code: int
     message: str = ""  # a fragment the one-line error must contain
+    #: Checks after the command (e.g. that the user's files are untouched); raises on failure.
+    check: Callable[[Path], None] | None = None
+    #: Run in a fresh interpreter: stderr as a user sees it, Dask's own logging included.
+    isolated: bool = False
+    #: RLIMIT_FSIZE of the command: a write past it fails (EFBIG) as on a full disk.
+    max_file_bytes: int | None = None
 
 
 # ----------------------------------------------------------------------------- recordings
@@ -783,6 +792,384 @@ def _model_and_cache_cases() -> list[Case]:
     ]
 
 
+# ----------------------------------------------------------------------------- issue 28
+
+
+def mine(root: Path, *names: str) -> None:
+    """Files the user made, each holding ``the user's <name>``."""
+    for name in names:
+        (root / name).parent.mkdir(parents=True, exist_ok=True)
+        (root / name).write_text(f"the user's {name}\n")
+
+
+def kept(*names: str) -> Callable[[Path], None]:
+    """A check that the user's files of :func:`mine` are still there, unchanged."""
+
+    def check(root: Path) -> None:
+        for name in names:
+            assert (root / name).read_text() == f"the user's {name}\n", name
+
+    return check
+
+
+def device(path: Path, minor: int) -> Path:
+    """A private copy of a memory device: /dev/null (minor 3) or /dev/full (minor 7)."""
+    try:
+        os.mknod(path, stat.S_IFCHR | 0o666, os.makedev(1, minor))
+    except PermissionError:
+        pytest.skip("creating a device node needs CAP_MKNOD")
+    return path
+
+
+def still_a_device(name: str) -> Callable[[Path], None]:
+    def check(root: Path) -> None:
+        assert stat.S_ISCHR(os.lstat(root / name).st_mode), f"{name} was replaced"
+
+    return check
+
+
+def two_point_sweep(rec: Path, out: Path, *extra: str, cluster: str = "local:1") -> list[str]:
+    """A sweep of min_confidence over -1 and 0 on ``rec`` (one in-process worker)."""
+    grid = ["sweep", "tracker.min_confidence", "-1", "0", "--dataset", str(rec)]
+    return [*grid, "--cluster", cluster, "--out", str(out), *extra]
+
+
+def sweep_records(folder: Path) -> list[dict[str, object]]:
+    """A sweep's records without their timings."""
+    data = json.loads((folder / "sweep.json").read_text())
+    return [{k: v for k, v in r.items() if "second" not in k} for r in data["records"]]
+
+
+def _ownership_cases() -> list[Case]:
+    """Outputs replace nothing but a regular file the same command wrote (issue 28)."""
+
+    def cmp_reports(root: Path) -> tuple[Path, Path]:
+        (root / "base1").mkdir()
+        (root / "base1" / "report.json").write_text(json.dumps(report(BASE_METRICS)))
+        (root / "cur.json").write_text(json.dumps(report(BASE_METRICS)))
+        return root / "base1" / "report.json", root / "cur.json"
+
+    def compare_onto(option: str, target: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            base, cur = cmp_reports(root)
+            return ["compare", str(base), str(cur), option, str(root / target)]
+
+        return build
+
+    def compare_into_device(minor: int) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            base, cur = cmp_reports(root)
+            return ["compare", str(base), str(cur), "--markdown", str(device(root / "DEV", minor))]
+
+        return build
+
+    def bench_into_full(root: Path) -> list[str]:
+        rec = good_recording(root)
+        html = str(device(root / "DEV", 7))
+        return ["bench", str(rec), "--repeat", "1", "--all-cores", "--html", html]
+
+    def preview_into_full(root: Path) -> list[str]:
+        return ["synth", "demo", "--frames", "1", "--preview", str(device(root / "DEV", 7))]
+
+    def run_into_users(*names: str, force: bool = False) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            mine(root, *(f"out/{n}" for n in names))
+            args = ["run", str(good_recording(root)), "--out", str(root / "out")]
+            return [*args, "--force"] if force else args
+
+        return build
+
+    def run_into_sweep_folder(root: Path) -> list[str]:
+        rec = good_recording(root)
+        first = run_isolated(two_point_sweep(rec, root / "res"), root)
+        assert first.code == 0, first.stderr
+        return ["run", str(rec), "--out", str(root / "res")]
+
+    def sweep_kept(root: Path) -> None:
+        names = {p.name for p in (root / "res").iterdir()}
+        assert {"sweep.csv", "sweep.json", "sweep.html", "sweep.png", "report.json"} <= names
+        assert len(sweep_records(root / "res")) == 2
+
+    def score_into_run_folder(root: Path) -> list[str]:
+        first = run_isolated(["run", str(good_recording(root)), "--out", str(root / "res")], root)
+        assert first.code == 0, first.stderr
+        (root / "t.txt").write_text(MOT_TRACKS)
+        (root / "g.txt").write_text(MOT_GT)
+        return [
+            "score",
+            str(root / "t.txt"),
+            "--gt",
+            str(root / "g.txt"),
+            "--out",
+            str(root / "res"),
+        ]
+
+    def run_kept(root: Path) -> None:
+        names = {p.name for p in (root / "res").iterdir()}
+        assert {"rec.tracks.csv", "rec.detections.csv", "rec.birdseye.png"} <= names
+        assert json.loads((root / "res" / "report.json").read_text())["sequences"][0]["frames"]
+
+    def import_over_sidecar(root: Path) -> list[str]:
+        from tests.io.epfl_folder import write_sequence
+
+        folder = write_sequence(root, [(4.0, 0.0)])
+        mine(root, "x.gt.csv")
+        return ["import", "epfl-rgbd", str(folder), "-o", str(root / "x.mcap")]
+
+    def synth_over_sidecar(root: Path) -> list[str]:
+        mine(root, "rig.bag", "rig.gt.csv")  # the user's recording and its annotations
+        return ["synth", "demo", "--frames", "1", "-o", str(root / "rig.mcap")]
+
+    return [
+        Case(
+            "bench_html_dev_full", "DATALOSS", bench_into_full, 7, "device", still_a_device("DEV")
+        ),
+        Case(
+            "cmp_html_onto_current",
+            "DATALOSS",
+            compare_onto("--html", "cur.json"),
+            7,
+            "input",
+            lambda root: json.loads((root / "cur.json").read_text()),
+        ),
+        Case("cmp_markdown_dev_full", "DATALOSS", compare_into_device(7), 7, "device"),
+        Case("cmp_markdown_dev_null_private", "DATALOSS", compare_into_device(3), 7, "device"),
+        Case(
+            "cmp_markdown_onto_baseline",
+            "DATALOSS",
+            compare_onto("--markdown", "base1/report.json"),
+            7,
+            "input",
+            lambda root: json.loads((root / "base1" / "report.json").read_text()),
+        ),
+        Case("synth_preview_dev_full", "DATALOSS", preview_into_full, 7, "device"),
+        Case(
+            "out_force_user_report_md",
+            "DATALOSS",
+            run_into_users("report.md", "notes.txt", force=True),
+            7,
+            "report.md",
+            kept("out/report.md", "out/notes.txt"),
+        ),
+        Case(
+            "out_force_user_report_html",
+            "DATALOSS",
+            run_into_users("report.html", force=True),
+            7,
+            "report.html",
+            kept("out/report.html"),
+        ),
+        Case(
+            "out_user_report_json_no_manifest",
+            "DATALOSS",
+            run_into_users("report.json"),
+            7,
+            "--force",
+            kept("out/report.json"),
+        ),
+        Case(
+            "out_force_user_tracks_csv",
+            "DATALOSS",
+            run_into_users("rec.tracks.csv", force=True),
+            7,
+            "rec.tracks.csv",
+            kept("out/rec.tracks.csv"),
+        ),
+        Case(
+            "out_run_into_sweep_folder",
+            "DATALOSS",
+            run_into_sweep_folder,
+            0,
+            check=sweep_kept,
+            isolated=True,
+        ),
+        Case(
+            "out_score_into_run_folder",
+            "DATALOSS",
+            score_into_run_folder,
+            7,
+            "written by `rgbd-eval run`",
+            run_kept,
+            isolated=True,
+        ),
+        Case(
+            "import_over_users_sidecar",
+            "DATALOSS",
+            import_over_sidecar,
+            7,
+            "x.gt.csv",
+            kept("x.gt.csv"),
+        ),
+        Case(
+            "synth_new_mcap_over_users_sidecar",
+            "DATALOSS",
+            synth_over_sidecar,
+            7,
+            "rig.gt.csv",
+            kept("rig.bag", "rig.gt.csv"),
+        ),
+    ]
+
+
+def _path_and_disk_cases() -> list[Case]:
+    def javascript_video(root: Path) -> list[str]:
+        rec = good_recording(root, "javascript:alert(document.domain).mcap")
+        return ["run", str(rec), "--video", "--out", str(root / "out")]
+
+    def relative_link(root: Path) -> None:
+        page = (root / "out" / "report.html").read_text()
+        assert 'href="javascript:' not in page
+        assert 'href="./javascript%3Aalert%28document.domain%29.overlay.mp4"' in page
+
+    def long_out(root: Path) -> list[str]:
+        return ["run", str(good_recording(root)), "--out", str(root / ("o" * 300))]
+
+    def synth_on_full_disk(root: Path) -> list[str]:
+        (root / "full").mkdir()
+        return ["synth", "demo", "--frames", "5", "-o", str(root / "full" / "x.mcap")]
+
+    def run_on_full_disk(root: Path) -> list[str]:
+        return ["run", str(good_recording(root)), "--out", str(root / "out")]
+
+    def out_symlink(root: Path) -> list[str]:
+        (root / "real").mkdir()
+        (root / "out").symlink_to("real")
+        return ["run", str(good_recording(root)), "--out", str(root / "out")]
+
+    def written_through_the_link(root: Path) -> None:
+        assert (root / "out").is_symlink()
+        assert json.loads((root / "real" / "report.json").read_text())["sequences"]
+
+    return [
+        Case(
+            "html_video_link_javascript",
+            "INJECTION",
+            javascript_video,
+            0,
+            check=relative_link,
+        ),
+        Case("out_name_300_chars", "TRACEBACK", long_out, 7, "too long"),
+        Case(
+            "full_synth",
+            "TRACEBACK",
+            synth_on_full_disk,
+            7,
+            "cannot write",
+            isolated=True,
+            max_file_bytes=100_000,
+        ),
+        Case(
+            "full_run",
+            "TRACEBACK",
+            run_on_full_disk,
+            7,
+            "cannot write",
+            isolated=True,
+            max_file_bytes=20_000,
+        ),
+        Case(
+            "out_symlink_to_empty_dir",
+            "WRONG-CODE",
+            out_symlink,
+            0,
+            check=written_through_the_link,
+        ),
+    ]
+
+
+def _cluster_and_cache_cases() -> list[Case]:
+    def reproduce(*extra: str) -> Callable[[Path], list[str]]:
+        """``reproduce basso2012`` with ``extra`` options ({root} is the case's folder)."""
+
+        def build(root: Path) -> list[str]:
+            mine(root, "f")
+            data, out = str(root / "d"), str(root / "o")
+            options = [e.format(root=root) for e in extra]
+            return ["reproduce", "basso2012", *options, "--data", data, "--out", out]
+
+        return build
+
+    def cluster(address: str) -> Callable[[Path], list[str]]:
+        return lambda root: two_point_sweep(good_recording(root), root / "out", cluster=address)
+
+    def folder_with_a_broken_recording(root: Path) -> list[str]:
+        (root / "set").mkdir()
+        good = good_recording(root / "set", "a.mcap")
+        (root / "set" / "bad.mcap").write_bytes(good.read_bytes()[:20_000])
+        return ["run", str(root / "set"), "--cluster", "local:1", "--out", str(root / "out")]
+
+    def cache_entry(damage: Callable[[Path], None], *mode: str) -> Callable[[Path], list[str]]:
+        """A sweep into s1 with a cache, its entry damaged, then the same sweep into s2."""
+
+        def build(root: Path) -> list[str]:
+            rec = good_recording(root)
+            extra = ("--cache", str(root / "cache"), *mode)
+            first = run_isolated(two_point_sweep(rec, root / "s1", *extra), root)
+            assert first.code == 0, first.stderr
+            (entry,) = (root / "cache").rglob("*.det")
+            damage(entry)
+            return two_point_sweep(rec, root / "s2", *extra)
+
+        return build
+
+    def fifo(entry: Path) -> None:
+        entry.unlink()
+        os.mkfifo(entry)
+
+    def dev_zero(entry: Path) -> None:
+        entry.unlink()
+        entry.symlink_to("/dev/zero")
+
+    def flip_a_float(entry: Path) -> None:
+        flip_byte(entry, entry.stat().st_size // 2)
+
+    def same_records(root: Path) -> None:
+        assert sweep_records(root / "s1") == sweep_records(root / "s2")
+        assert len(sweep_records(root / "s2")) == 2
+
+    return [
+        Case("reproduce_cache_is_file", "HANG", reproduce("--cache", "{root}/f"), 7, "cache"),
+        Case("reproduce_cluster_bogus", "HANG", reproduce("--cluster", "mars://x"), 4, "--cluster"),
+        Case("cluster_tls_127_0_0_1_1", "TRACEBACK", cluster("tls://127.0.0.1:1"), 8, "tls"),
+        Case("cluster_ucx_127_0_0_1_1", "TRACEBACK", cluster("ucx://127.0.0.1:1"), 8, "ucx"),
+        Case(
+            "multi_folder_one_broken",
+            "MULTILINE",
+            folder_with_a_broken_recording,
+            3,
+            "bad.mcap",
+            isolated=True,
+        ),
+        Case(
+            "cache_client_mode_float",
+            "MULTILINE",
+            cache_entry(flip_a_float, "--cache-mode", "client"),
+            0,
+            "checksum mismatch",
+            same_records,
+            isolated=True,
+        ),
+        Case(
+            "cache_fifo_entry",
+            "HANG",
+            cache_entry(fifo),
+            0,
+            "named pipe",
+            same_records,
+            isolated=True,
+        ),
+        Case(
+            "cache_devzero_entry",
+            "TRACEBACK",
+            cache_entry(dev_zero),
+            0,
+            "device",
+            same_records,
+            isolated=True,
+        ),
+    ]
+
+
 def all_cases() -> list[Case]:
     """Every case of the corpus."""
     return [
@@ -796,6 +1183,9 @@ def all_cases() -> list[Case]:
         *_damage_cases(),
         *_score_cases(),
         *_model_and_cache_cases(),
+        *_ownership_cases(),
+        *_path_and_disk_cases(),
+        *_cluster_and_cache_cases(),
     ]
 
 

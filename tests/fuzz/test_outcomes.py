@@ -16,7 +16,7 @@ import pytest
 
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import DEPTH_INFO_TOPIC
-from tests.fuzz.cli import leftovers, run_cli
+from tests.fuzz.cli import SRC, leftovers, run_cli
 from tests.fuzz.corpus import (
     DAMAGED_DEPTH_TOPIC,
     FRAMES,
@@ -119,10 +119,37 @@ def test_sweep_writes_all_outputs_or_none(
     assert leftovers(tmp_path) == []
 
 
-def test_sigterm_during_run_cleans_up(tmp_path: Path) -> None:
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_inside_a_c_extension_is_an_interruption(
+    signum: int,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """A signal handled while numba's dispatcher runs Python code reaches us as a SystemError
+    whose cause is our Interrupted (issue 28, sig_run_hup: a traceback and exit 1)."""
+    import rgbd_eval.pipeline
+    from rgbd_eval.cli.common import Interrupted
+
+    def dispatcher(*args: object, **kwargs: object) -> None:
+        try:
+            raise Interrupted(signum)  # what the handler raises
+        except Interrupted as err:
+            raise SystemError("CPUDispatcher(<function _back_project>) returned a result") from err
+
+    monkeypatch.setattr(rgbd_eval.pipeline, "run_sequence", dispatcher)
+    out = tmp_path / "out"
+    result = run_cli(["run", str(good_recording(tmp_path)), "--out", str(out)], capsys)
+    assert result.code == 128 + signum, result.stderr
+    assert result.error_lines == [f"error: interrupted by signal {signum}"]
+    assert not out.exists() and leftovers(tmp_path) == []
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_during_run_cleans_up(signum: int, tmp_path: Path) -> None:
     rec = good_recording(tmp_path)
     out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=str(Path(__file__).resolve().parents[2] / "src"))
+    env = dict(os.environ, PYTHONPATH=str(SRC))
     proc = subprocess.Popen(
         [sys.executable, "-m", "rgbd_eval", "run", str(rec), "--out", str(out)],
         stderr=subprocess.PIPE,
@@ -134,12 +161,12 @@ def test_sigterm_during_run_cleans_up(tmp_path: Path) -> None:
         if leftovers(tmp_path) or proc.poll() is not None:
             break
         time.sleep(0.05)
-    proc.send_signal(signal.SIGTERM)
+    proc.send_signal(signum)
     _, stderr = proc.communicate(timeout=120)
     if proc.returncode == 0:
-        pytest.skip("the run finished before SIGTERM arrived")
-    assert proc.returncode == 128 + signal.SIGTERM, stderr
-    assert stderr.strip().splitlines()[-1] == f"error: interrupted by signal {int(signal.SIGTERM)}"
+        pytest.skip("the run finished before the signal arrived")
+    assert proc.returncode == 128 + signum, stderr
+    assert stderr.strip().splitlines() == [f"error: interrupted by signal {int(signum)}"]
     assert leftovers(tmp_path) == [] and not out.exists()
 
 

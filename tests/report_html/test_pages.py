@@ -34,16 +34,17 @@ class _Refs(HTMLParser):
 def external_references(html: str) -> list[str]:
     """Everything in ``html`` that would make a browser fetch something outside the file.
 
-    Allowed: ``data:`` URIs, ``#fragments`` and bare relative names of files beside the
-    page (the overlay video). Anything with a scheme (``http:``, ``file:``, ``//host``),
-    CSS ``url(...)`` or ``@import`` is external.
+    Allowed: ``data:`` URIs, ``#fragments`` and relative names of files beside the
+    page (``./<name>``, the overlay video). Anything with a scheme (``http:``, ``file:``,
+    ``//host``), CSS ``url(...)`` or ``@import`` is external.
     """
     parser = _Refs()
     parser.feed(html)
     bad = [
         r
         for r in parser.refs
-        if not r.startswith(("data:", "#")) and (":" in r or r.startswith("/") or "/" in r)
+        if not r.startswith(("data:", "#"))
+        and (":" in r or r.startswith("/") or "/" in r.removeprefix("./"))
     ]
     # ':' is not in the base64 alphabet, so a scheme cannot hide inside an inline image.
     bad += re.findall(r"[a-zA-Z][a-zA-Z0-9+.-]*://[^\s\"'<>)]*", html)
@@ -56,7 +57,8 @@ def test_the_checker_finds_external_references() -> None:
         '<link href="https://cdn.example/x.css"><img src="//host/a.png">'
         '<script src="/abs/x.js"></script><style>a{background:url(b.png)}</style>'
         '<a href="sub/dir.html">x</a><img src="data:image/png;base64,AAAA"><a href="#top">t</a>'
-        '<a href="demo.overlay.mp4">video</a>'
+        '<a href="demo.overlay.mp4">video</a><a href="./a.overlay.mp4">video</a>'
+        '<a href="./javascript:alert(1)">x</a><a href="javascript:alert(1)">x</a>'
     )
     found = external_references(page)
     for expected in (
@@ -65,6 +67,8 @@ def test_the_checker_finds_external_references() -> None:
         "/abs/x.js",
         "url(b.png)",
         "sub/dir.html",
+        "./javascript:alert(1)",
+        "javascript:alert(1)",
     ):
         assert any(expected in f for f in found), expected
     assert not any("data:" in f or f == "#top" or "overlay" in f for f in found)
@@ -90,7 +94,7 @@ def test_run_writes_html_plots_and_video_beside_the_report(run_dir: Path) -> Non
     finally:
         video.release()
     html = (run_dir / "report.html").read_text()
-    assert 'href="short.overlay.mp4"' in html
+    assert 'href="./short.overlay.mp4"' in html
 
 
 @pytest.mark.parametrize(

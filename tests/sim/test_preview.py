@@ -8,6 +8,8 @@ import cv2
 import numpy as np
 import pytest
 
+from rgbd_eval.errors import OutputError
+from rgbd_eval.outdir import MANIFEST
 from rgbd_eval.sim.preview import contact_sheet, default_frames, depth_colour, write_preview
 from rgbd_eval.sim.scenario import Scenario
 
@@ -19,7 +21,13 @@ def test_write_preview(tmp_path: Path, tiny: Scenario) -> None:
     # 3 tiles of 160x120 in 2 columns -> 2 rows: 320 x 240
     assert img.shape == (240, 320, 3)
     assert not np.any(img[120:, 160:])  # the missing fourth tile stays black
-    assert list((tmp_path / "sub").iterdir()) == [out]  # no temporary file left
+    # No temporary file left; the folder's manifest records the sheet as synth's.
+    assert sorted(p.name for p in (tmp_path / "sub").iterdir()) == [MANIFEST, "sheet.png"]
+    write_preview(tiny, out, seed=1, frames=[0])  # synth's own preview: replaced
+    out.write_bytes(b"edited")
+    with pytest.raises(OutputError, match="changed since"):
+        write_preview(tiny, out, seed=0, frames=[0])
+    assert out.read_bytes() == b"edited"
 
 
 def test_helpers() -> None:

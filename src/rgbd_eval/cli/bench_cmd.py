@@ -21,6 +21,7 @@ from rgbd_eval.cli.common import (
     topic_overrides,
 )
 from rgbd_eval.config import load_config
+from rgbd_eval.outdir import check_output_file
 
 if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
@@ -137,6 +138,8 @@ def bench(
         [*(overrides or []), *topic_overrides(topics)],
         method=method or (None if config_file else "basso2012"),
     )
+    if html_file is not None:  # before any work; never the recording itself
+        check_output_file(html_file, "bench", [path] if path is not None else [])
     target = path if path is not None else ensure_demo()
     if not all_cores:
         one_core()
@@ -147,7 +150,7 @@ def bench(
         from rgbd_eval.atomic import write_text
         from rgbd_eval.report_html import bench_page
 
-        write_text(html_file, bench_page(result, STAGE_LABELS))
+        write_text(html_file, bench_page(result, STAGE_LABELS), "bench")
     if json_out:
         typer.echo(json.dumps(result.to_json(), indent=2))
     else:

@@ -121,6 +121,38 @@ class Interrupted(BaseException):
         self.signum = signum
 
 
+def interruption(err: BaseException) -> int | None:
+    """The signal behind ``err`` when it is an interruption, else None.
+
+    A signal handled while a C extension runs Python code (numba's dispatcher loading its
+    cache, say) can reach us as a ``SystemError`` ("returned a result with an exception
+    set") whose cause is the :class:`Interrupted` or ``KeyboardInterrupt`` we raised.
+    """
+    seen: BaseException | None = err
+    for _ in range(20):  # a cause chain is short; never loop on a cycle
+        if seen is None:
+            return None
+        if isinstance(seen, Interrupted):
+            return seen.signum
+        if isinstance(seen, KeyboardInterrupt):
+            return int(signal.SIGINT)
+        if not isinstance(seen, SystemError):
+            return None
+        seen = seen.__cause__ or seen.__context__
+    return None
+
+
+def interrupted_line(signum: int) -> str:
+    """The one error line of an interruption by ``signum``."""
+    return "error: interrupted" + ("" if signum == signal.SIGINT else f" by signal {signum}")
+
+
+def interrupted_exit(signum: int) -> typer.Exit:
+    """Print the one line of an interruption; the exit to raise (128 + the signal)."""
+    typer.echo(interrupted_line(signum), err=True)
+    return typer.Exit(128 + signum)
+
+
 def one_line(message: str) -> str:
     """``message`` on one line (whitespace runs collapsed) and at most MAX_MESSAGE_CHARS long."""
     text = " ".join(message.split())
@@ -141,11 +173,14 @@ def handle_errors(func: Callable[P, R]) -> Callable[P, R]:
             typer.echo(f"error: {one_line(str(err))}", err=True)
             raise typer.Exit(err.exit_code) from None
         except KeyboardInterrupt:  # outputs were removed on the way out (staged folders)
-            typer.echo("error: interrupted", err=True)
-            raise typer.Exit(128 + signal.SIGINT) from None
+            raise interrupted_exit(signal.SIGINT) from None
         except Interrupted as err:
-            typer.echo(f"error: interrupted by signal {err.signum}", err=True)
-            raise typer.Exit(128 + err.signum) from None
+            raise interrupted_exit(err.signum) from None
+        except SystemError as err:  # a signal that surfaced through a C extension
+            signum = interruption(err)
+            if signum is None:
+                raise
+            raise interrupted_exit(signum) from None
 
     return wrapper
 

@@ -10,6 +10,7 @@ from rich.table import Table
 
 from rgbd_eval.atomic import write_text
 from rgbd_eval.cli.common import console, handle_errors, one_line
+from rgbd_eval.outdir import check_output_file
 
 
 @handle_errors
@@ -40,6 +41,10 @@ def compare(
     )
 
     tolerances = parse_tolerances(tolerance or [])  # bad arguments fail before any file is read
+    inputs = [baseline, baseline / "report.json", current, current / "report.json"]
+    for output in (markdown_file, html_file):
+        if output is not None:  # before the reports are read; never one of them
+            check_output_file(output, "compare", inputs)
     comparison = compare_reports(load_report(baseline), load_report(current), tolerances)
     table = Table(title=f"{baseline} -> {current}", title_justify="left")
     for i, head in enumerate(HEADER):
@@ -59,11 +64,11 @@ def compare(
     for note in comparison.notes:
         typer.echo(f"note: {one_line(note)}", err=True)
     if markdown_file is not None:
-        write_text(markdown_file, markdown(comparison))
+        write_text(markdown_file, markdown(comparison), "compare")
     if html_file is not None:
         from rgbd_eval.report_html import compare_page
 
-        write_text(html_file, compare_page(comparison, str(baseline), str(current)))
+        write_text(html_file, compare_page(comparison, str(baseline), str(current)), "compare")
     if comparison.regressions:
         lost = [d for d in comparison.regressions if d.status is Status.MISSING]
         worse = [d for d in comparison.regressions if d.status is Status.REGRESSED]

@@ -119,7 +119,7 @@ def import_(
     frames: Annotated[int | None, typer.Option(help="convert only the first N frames")] = None,
 ) -> None:
     """Convert a dataset sequence folder to .mcap/.bag (depth, colour, CameraInfo, tf) + <name>.gt.csv."""
-    from rgbd_eval.io.epfl_rgbd import annotation_path, import_sequence, scan_sequence
+    from rgbd_eval.io.epfl_rgbd import OWNER, annotation_path, import_sequence, scan_sequence
 
     if fmt not in FORMATS:
         raise ConfigError(f"format {fmt!r}: expected one of {', '.join(FORMATS)}")
@@ -131,7 +131,11 @@ def import_(
         raise ConfigError(f"--frames {frames}: must be at least 1")
     if no_gt and annotations is not None:
         raise ConfigError("--no-gt and --annotations contradict each other")
-    check_output_file(out)
+    # The recording and its sidecar replace only files `import` wrote (a user's annotations
+    # named <name>.gt.csv beside it are never replaced); checked before any work.
+    check_output_file(out, OWNER)
+    if not no_gt:
+        check_output_file(out.with_name(f"{out.stem}.gt.csv"), OWNER)
     camera = _camera(intrinsics)
     sequence = scan_sequence(source)
     if not no_gt and annotations is None:

@@ -15,7 +15,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
 
 from rgbd_eval import __version__
 from rgbd_eval.cli.bench_cmd import bench
-from rgbd_eval.cli.common import Interrupted, one_line
+from rgbd_eval.cli.common import Interrupted, interrupted_line, interruption, one_line
 from rgbd_eval.cli.compare_cmd import compare
 from rgbd_eval.cli.import_cmd import import_
 from rgbd_eval.cli.inspect_cmd import inspect
@@ -88,4 +88,10 @@ def main() -> None:
     except typer.Abort:  # Ctrl-C (click turns KeyboardInterrupt into Abort)
         typer.echo("error: interrupted", err=True)
         sys.exit(128 + signal.SIGINT)
+    except SystemError as err:  # a signal that surfaced through a C extension (see interruption)
+        number = interruption(err)
+        if number is None:
+            raise
+        typer.echo(interrupted_line(number), err=True)
+        sys.exit(128 + number)
     sys.exit(code if isinstance(code, int) else 0)

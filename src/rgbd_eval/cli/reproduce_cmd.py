@@ -50,20 +50,25 @@ def reproduce(
         return
     spec = paper_spec(system)  # ConfigError listing the known papers
     from rgbd_eval.atomic import write_json, write_text
+    from rgbd_eval.cache import DetectionCache
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.report_html import reproduce_page
     from rgbd_eval.sim import ensure_scenario
 
+    # Every option is checked before the scenarios are generated (that takes minutes).
     if data is not None and data.exists() and not data.is_dir():  # was FileExistsError
         raise OutputError(data, "--data is not a folder (it holds the generated recordings)")
+    cluster_spec = parse_cluster(cluster_of(cluster, jobs))
+    DetectionCache(cache)  # refuses a cache path that is a file
     out_dir = out or Path("runs") / f"reproduce-{system}-{time.strftime('%Y%m%d-%H%M%S')}"
+    names = ["reproduce.md", "reproduce.html"]
     # The output folder is checked and staged before the scenarios are generated and run.
-    with OutputFolder(out_dir, "reproduce.json", force) as folder:
+    with OutputFolder(out_dir, "reproduce.json", force, command="reproduce", names=names) as folder:
         recordings = {
             Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
             for name in spec.scenarios
         }
-        with connect(parse_cluster(cluster_of(cluster, jobs))) as client:
+        with connect(cluster_spec) as client:
             options = ReproduceOptions(
                 client=client, cache=cache, progress=lambda m: err_console.print(m)
             )

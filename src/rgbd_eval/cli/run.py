@@ -132,7 +132,7 @@ def run(
     ] = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
-    from rgbd_eval.pipeline import run_sequence  # heavy imports only when needed
+    from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
     from rgbd_eval.report import REPORT_FILE, run_warnings, write_run
     from rgbd_eval.report_html import write_run_html
 
@@ -151,7 +151,12 @@ def run(
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
-    with OutputFolder(out_dir, REPORT_FILE, force) as folder:
+    # What this run will write, checked against what the folder holds before any work.
+    names = ["report.md", "report.html"]
+    kinds = ["detections.csv", "tracks.csv", "birdseye.png", *(["overlay.mp4"] if video else [])]
+    for p in recordings:
+        names += [f"{sequence_name(p)}.{k}" for k in kinds]
+    with OutputFolder(out_dir, REPORT_FILE, force, command="run", names=names) as folder:
         # The output folder is checked and staged before this work.
         if cluster is None and len(recordings) == 1:
             with progress_bar() as bar:  # one recording: a bar over its frames

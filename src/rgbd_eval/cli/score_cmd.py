@@ -84,7 +84,9 @@ def score(
         raise ConfigError(f"--benchmark {benchmark!r}: expected one of {known}") from err
     max_gap_ns = int(config.io.max_sync_gap_ms * 1e6)
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-score"
-    folder = OutputFolder(out_dir, "report.json", force)
+    folder = OutputFolder(
+        out_dir, "report.json", force, command="score", names=["report.md", "report.html"]
+    )
     # The output folder is checked and staged before any input is read, as for run.
     with folder:
         pairs = sequence_pairs(tracks, gt)

@@ -187,7 +187,13 @@ def sweep(
     spec = parse_cluster(cluster_of(cluster, jobs), tasks=len(grid) * len(recordings))
     console.print(f"sweep: {len(grid)} points x {len(recordings)} sequences, {spec.describe()}")
     g = configs[0].evaluation.gating if configs else Gating.IOU
-    folder = OutputFolder(out_dir, "sweep.json", force)
+    folder = OutputFolder(
+        out_dir,
+        "sweep.json",
+        force,
+        command="sweep",
+        names=["sweep.csv", "sweep.html", "sweep.png"],
+    )
     with folder:  # checked and staged before the sweep; published whole or not at all
         start = time.perf_counter()
         with connect(spec) as client, progress_bar() as bar:

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING, Annotated, Literal
 import typer
 
 from rgbd_eval.cli.common import advance_callback, console, handle_errors, progress_bar
-from rgbd_eval.errors import ConfigError
+from rgbd_eval.errors import ConfigError, OutputError
 from rgbd_eval.outdir import check_output_file
 
 if TYPE_CHECKING:
@@ -68,6 +68,7 @@ def synth(
     from rgbd_eval.config import parse_overrides
     from rgbd_eval.sim import dataset_path, load_scenario, scenario_paths, synthesize, write_preview
     from rgbd_eval.sim.stereo_rig import with_stereo_rig
+    from rgbd_eval.sim.synth import OWNER, ground_truth_path
 
     changes = parse_overrides(overrides or [])
     if rig not in (None, "stereo"):
@@ -86,9 +87,16 @@ def synth(
     if out is not None and out.suffix not in ("", f".{fmt}"):
         raise ConfigError(f"--out {out}: a {fmt} recording needs a .{fmt} name")
     container: Literal["ros1", "mcap"] = "ros1" if fmt == "bag" else "mcap"
-    for target in (out, preview):
-        if target is not None:
-            check_output_file(target)  # before rendering; never replaces a folder
+    targets = [preview]
+    if out is not None:  # the recording, its ground truth and (--follow) its following record
+        targets += [out, ground_truth_path(out)]
+        if follow is not None:
+            from rgbd_eval.follow import follow_paths
+
+            targets += follow_paths(out)
+    for target in targets:
+        if target is not None:  # before rendering: only files synth wrote are replaced
+            check_output_file(target, OWNER)
     if all_scenarios:
         if scenario is not None or out is not None or preview is not None:
             raise ConfigError(
@@ -143,6 +151,8 @@ def _follow(
         result = follow(scenario, target, seed, None, None, out, container, frames, advance)
     except ValueError as err:
         raise ConfigError(f"{scenario.name}: {err}") from err
+    except OSError as err:  # a full disk: the recording's writer removed its temporary file
+        raise OutputError(out, f"cannot write ({err.strerror or err})") from err
     csv_path, json_path = write_follow(result, out)
     s = result.summary
 

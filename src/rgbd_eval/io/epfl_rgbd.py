@@ -58,10 +58,13 @@ from rgbd_eval.errors import DecodeError, GroundTruthError, InputError, OutputEr
 from rgbd_eval.files import check_input, parse_yaml, read_text
 from rgbd_eval.io.groundtruth import MAX_ID, write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
+from rgbd_eval.outdir import check_output_file
 from rgbd_eval.types import Box2D, CameraModel, GroundTruthObject, Pose
 
 #: The annotation file of an environment folder.
 ANNOTATION_FILE = "ground_truth_image_plane.yaml"
+#: The writer of imported recordings and sidecars in a folder's manifest (rgbd_eval.outdir).
+OWNER = "import"
 #: Image size of the Kinect v2 depth camera (and of the registered colour images).
 WIDTH, HEIGHT = 512, 424
 #: The optical frame both images are written in (colour is registered to depth).
@@ -438,8 +441,10 @@ def import_sequence(
     csv_path = out.with_name(f"{out.stem}.gt.csv") if annotations is not None else None
     objects: list[GroundTruthObject] = []
     positions = 0
+    if csv_path is not None:  # before any work, as the recording is (by its writer)
+        check_output_file(csv_path, OWNER)
     try:
-        writer = RecordingWriter(out, options=StreamOptions(depth_encoding="16UC1"), overwrite=True)
+        writer = RecordingWriter(out, options=StreamOptions(depth_encoding="16UC1"), owner=OWNER)
     except (IsADirectoryError, ValueError) as err:
         raise OutputError(out, str(err)) from err
     try:
@@ -466,7 +471,7 @@ def import_sequence(
                 if progress is not None:
                     progress(index + 1, len(frames))
         if csv_path is not None:
-            write_csv(csv_path, objects)
+            write_csv(csv_path, objects, OWNER)
     except OSError as err:  # disk full, permissions: the writer removed its temp file
         raise OutputError(out, f"cannot write ({err.strerror or err})") from err
     last = frames[-1].number

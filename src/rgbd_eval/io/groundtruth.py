@@ -21,7 +21,6 @@ from __future__ import annotations
 import csv
 import io
 import math
-import os
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from decimal import Decimal, InvalidOperation
@@ -30,6 +29,7 @@ from typing import Any
 
 import numpy as np
 
+from rgbd_eval.atomic import write_text
 from rgbd_eval.errors import GroundTruthError
 from rgbd_eval.files import check_input, read_text
 from rgbd_eval.types import Box2D, GroundTruthObject
@@ -242,29 +242,28 @@ def _fmt(value: float | None) -> str:
     return repr(float(value))
 
 
-def write_csv(path: Path, objects: Iterable[GroundTruthObject]) -> None:
-    """Write the sidecar CSV atomically (temp file, then rename)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
-    with tmp.open("w", newline="", encoding="utf-8") as handle:
-        writer = csv.writer(handle)
-        writer.writerow(CSV_COLUMNS)
-        for o in objects:
-            box: tuple[float | None, ...] = o.box2d.as_tuple() if o.box2d else (None,) * 4
-            xyz: tuple[float | None, ...] = o.world_xyz if o.world_xyz else (None,) * 3
-            writer.writerow(
-                [
-                    o.frame,
-                    o.stamp_ns,
-                    o.object_id,
-                    *(_fmt(v) for v in box),
-                    *(_fmt(v) for v in xyz),
-                    _fmt(o.visibility),
-                    int(o.ignore),
-                ]
-            )
-    os.replace(tmp, path)
+def write_csv(path: Path, objects: Iterable[GroundTruthObject], owner: str | None = None) -> None:
+    """Write the sidecar CSV atomically (temp file, then rename); with ``owner`` (the
+    command) it replaces only a sidecar that command wrote (:func:`rgbd_eval.atomic.write_bytes`).
+    """
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\r\n")
+    writer.writerow(CSV_COLUMNS)
+    for o in objects:
+        box: tuple[float | None, ...] = o.box2d.as_tuple() if o.box2d else (None,) * 4
+        xyz: tuple[float | None, ...] = o.world_xyz if o.world_xyz else (None,) * 3
+        writer.writerow(
+            [
+                o.frame,
+                o.stamp_ns,
+                o.object_id,
+                *(_fmt(v) for v in box),
+                *(_fmt(v) for v in xyz),
+                _fmt(o.visibility),
+                int(o.ignore),
+            ]
+        )
+    write_text(Path(path), buf.getvalue(), owner)
 
 
 # ----------------------------------------------------------------------------- KTP

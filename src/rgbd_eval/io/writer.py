@@ -3,7 +3,9 @@
 One API for every container, so that a synthetic sequence can be written as a
 ROS1 bag and as a ROS2 MCAP with identical content. The output appears
 atomically: it is written under a temporary name and renamed when closed
-without error.
+without error. With ``owner`` (the command writing it) a single-file recording is
+an output the user named: it replaces only a recording that command wrote
+(:func:`rgbd_eval.outdir.check_output_file`, checked when the writer is made).
 """
 
 from __future__ import annotations
@@ -35,6 +37,7 @@ from rgbd_eval.io.messages import (
     TF_TYPE,
     typestore,
 )
+from rgbd_eval.outdir import check_output_file, publish_file
 from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
 
 Container = Literal["ros1", "mcap", "ros2-sqlite3", "ros2-mcap"]
@@ -98,12 +101,18 @@ class RecordingWriter:
         container: Container | None = None,
         options: StreamOptions | None = None,
         overwrite: bool = False,
+        owner: str | None = None,
     ) -> None:
         self.path = Path(path)
         self.container: Container = container or container_for_path(self.path)
         if self.container not in CONTAINERS:
             raise ValueError(f"container={self.container!r} must be one of {', '.join(CONTAINERS)}")
-        if self.path.exists() and not overwrite:
+        self.owner = owner
+        if owner is not None:
+            if self.container not in ("ros1", "mcap"):
+                raise ValueError(f"owner={owner!r} needs a single-file container (ros1 or mcap)")
+            check_output_file(self.path, owner)  # OutputError: not ours to replace
+        elif self.path.exists() and not overwrite:
             raise FileExistsError(f"{self.path} exists; pass overwrite=True to replace it")
         if self.path.is_dir() and not (self.path / "metadata.yaml").is_file():
             raise IsADirectoryError(f"{self.path} is a folder, not a recording: not replaced")
@@ -149,13 +158,20 @@ class RecordingWriter:
         if exc_type is not None:
             self._abort()
             return
-        if self.container == "mcap":
-            self._writer.finish()
-            self._mcap_file.close()
-        else:
-            self._writer.close()
-            if self.container != "ros1":
-                self._name_storage_files()
+        try:
+            if self.container == "mcap":
+                self._writer.finish()
+                self._mcap_file.close()
+            else:
+                self._writer.close()
+                if self.container != "ros1":
+                    self._name_storage_files()
+        except BaseException:  # a full disk fails here too: no half-written file is left
+            self._abort()
+            raise
+        if self.owner is not None:
+            publish_file(self._tmp, self.path, self.owner)  # removes the temporary file
+            return
         self._remove(self.path)
         os.replace(self._tmp, self.path)
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -10,8 +9,12 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval.atomic import write_bytes
+from rgbd_eval.errors import OutputError
+from rgbd_eval.outdir import check_output_file
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.simulate import SimFrame, Simulator
+from rgbd_eval.sim.synth import OWNER
 
 #: Box colours per id (RGB), cycled.
 _PALETTE = [
@@ -95,15 +98,19 @@ def write_preview(
     frames: Sequence[int] | None = None,
     columns: int = 3,
 ) -> Path:
-    """Render ``frames`` (default: six spread over the sequence) and write a PNG contact sheet."""
+    """Render ``frames`` (default: six spread over the sequence) and write a PNG contact sheet.
+
+    It replaces only a preview ``synth`` wrote (OutputError otherwise, or when it cannot
+    be written).
+    """
+    out = Path(png_path)
+    check_output_file(out, OWNER)
     sim = Simulator(scenario, seed)
     indices = list(frames) if frames is not None else default_frames(sim.n_frames)
     images = [annotate(sim.frame(i)) for i in indices]
     sheet = contact_sheet(images, columns)
-    out = Path(png_path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out.with_name(f".{out.name}.tmp-{os.getpid()}.png")
-    if not cv2.imwrite(str(tmp), sheet[..., ::-1]):
-        raise OSError(f"{out}: could not write PNG")
-    os.replace(tmp, out)
+    ok, png = cv2.imencode(".png", sheet[..., ::-1])
+    if not ok:
+        raise OutputError(out, "cannot encode the contact sheet as PNG")
+    write_bytes(out, png.tobytes(), OWNER)
     return out

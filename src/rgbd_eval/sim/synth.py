@@ -9,6 +9,7 @@ same ground truth.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -17,8 +18,10 @@ from typing import Literal
 
 from rgbd_eval import __version__
 from rgbd_eval.config import data_home
+from rgbd_eval.errors import OutputError
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
+from rgbd_eval.outdir import check_output_file
 from rgbd_eval.sim import rig
 from rgbd_eval.sim.rig_sensors import RigSensor, make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
@@ -27,6 +30,9 @@ from rgbd_eval.types import GroundTruthObject
 
 ProgressCallback = Callable[[int, int], None]
 SynthContainer = Literal["ros1", "mcap"]
+#: Who wrote a synthetic recording, its sidecar, preview and following record (the manifest's
+#: name for them, whichever command generated them: synth, or run/bench/reproduce on first use).
+OWNER = "synth"
 
 
 @dataclass(frozen=True)
@@ -136,32 +142,39 @@ def synthesize(
     ``seed`` defaults to the scenario's; ``progress(done, total)`` is called after
     every frame; ``max_frames`` truncates the sequence (tests, previews).
     Both files appear atomically. Same scenario and seed give the same bytes.
+    Either file replaces only one ``synth`` wrote, unchanged since (``overwrite=False``:
+    none); both are checked before rendering (OutputError, as for a full disk).
     """
     out = Path(out_path)
     kind: SynthContainer = container if container is not None else container_for(out)
     if kind not in ("ros1", "mcap"):
         raise ValueError(f"container={kind!r} must be 'ros1' or 'mcap'")
+    csv_path = ground_truth_path(out)
+    for target in (out, csv_path):
+        if not overwrite and os.path.lexists(target):
+            raise OutputError(target, "exists; not replaced")
+        check_output_file(target, OWNER)  # a user's annotations beside it are never replaced
     sim = Simulator(scenario, seed)
     total = sim.n_frames if max_frames is None else min(sim.n_frames, max_frames)
     if total < 1:
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     start = time.perf_counter()
     truth: list[GroundTruthObject] = []
-    with RecordingWriter(
-        out, container=kind, options=stream_options(scenario), overwrite=overwrite
-    ) as w:
-        extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
-        w.write_provenance(scenario.stamp_ns(0), provenance(sim, total, kind))
-        write_static(w, sim, extra)
-        for f in sim.frames(list(range(total))):
-            write_frame(w, sim, f)
-            for k, sensor in enumerate(extra):
-                sensor.write(w, sim.scene_view(f.index, k))
-            truth.extend(f.ground_truth)
-            if progress is not None:
-                progress(f.index + 1, total)
-    csv_path = ground_truth_path(out)
-    write_csv(csv_path, truth)
+    try:
+        with RecordingWriter(out, kind, stream_options(scenario), owner=OWNER) as w:
+            extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
+            w.write_provenance(scenario.stamp_ns(0), provenance(sim, total, kind))
+            write_static(w, sim, extra)
+            for f in sim.frames(list(range(total))):
+                write_frame(w, sim, f)
+                for k, sensor in enumerate(extra):
+                    sensor.write(w, sim.scene_view(f.index, k))
+                truth.extend(f.ground_truth)
+                if progress is not None:
+                    progress(f.index + 1, total)
+    except OSError as err:  # a full disk: the writer removed its temporary file
+        raise OutputError(out, f"cannot write ({err.strerror or err})") from err
+    write_csv(csv_path, truth, OWNER)
     elapsed = time.perf_counter() - start
     return SynthResult(out, csv_path, total, len(truth), elapsed, out.stat().st_size)
 
