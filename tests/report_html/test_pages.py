@@ -182,7 +182,11 @@ def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) 
     # MOTA = 1 - 3/4 = 25.0%; no world positions, so no bird's-eye plot and no images.
     assert "<td>25.0%</td>" in html
     assert "bird&#39;s-eye" not in html and "image/jpeg" not in html
-    assert html.count("<img ") == 1  # the error timeline
+    # The error timeline; the others are the analysis' plots (intervals, gap recovery).
+    assert html.count('alt="errors per frame of') == 1
+    assert html.count("<img ") == 1 + html.count('alt="metrics with their') + html.count(
+        'alt="recovery rate'
+    )
     assert not (pages["score"].parent / "tracks.birdseye.png").exists()
 
 

@@ -1,0 +1,597 @@
+"""95 % intervals by a circular block bootstrap over frames, and the paired bootstrap of ``compare``.
+
+Frames of a tracking sequence are not independent (a person missed in one frame is
+likely missed in the next), so a replicate resamples *blocks* of consecutive frames:
+the circular block bootstrap (Politis & Romano 1992) draws ``ceil(n / L)`` block starts
+uniformly from the ``n`` frames, takes ``L`` frames from each (wrapping at the end) and
+keeps the first ``n``. A replicate is then a weight per frame (how often it was drawn),
+and every summable count of the replicate is the weighted sum of the per-frame
+contributions recorded by the scorer (:class:`~rgbd_eval.metrics.frames.FrameTable`).
+IDF1 and HOTA have a global step: per replicate, IDF1's id assignment is solved again on
+the weighted pair counts, and HOTA's association (its alignment of ids over the
+sequence) is recomputed from the weighted pair, ground-truth and track counts; HOTA's
+per-frame pairs are those of the full sequence. The ratios of a replicate come from its
+sums by :func:`replicate_metrics`, the formulas of
+:func:`rgbd_eval.metrics.counts.summarize`; the interval is the 2.5th and 97.5th
+percentile of the replicates (the order statistics, no interpolation).
+
+Block length ``L``: chosen per sequence from its series of errors per frame (FN + FP +
+ID switches, the numerator of MOTA) by the automatic rule of Politis & White (2004, with
+the correction of Patton, Politis & White 2009) for the circular block bootstrap, at
+least 1 and at most ``ceil(min(3 sqrt(n), n / 3))``; a series without correlation gives
+``L = 1`` (the ordinary bootstrap). Several sequences: each is resampled on its own (its
+blocks, its length) and a replicate of the overall row is the sum of the sequences'
+replicates (a stratified bootstrap), ratios again from the sums.
+
+Deterministic for a seed (:data:`DEFAULT_SEED`, ``evaluation.bootstrap_seed``): each
+sequence draws from ``numpy.random.default_rng([seed, crc32(name)])`` (PCG64, integer
+arithmetic). The sums are of integer counts (exact in float64, in any order, so the
+matrix products may use BLAS); the one float sum (the similarity behind MOTP) is
+summed in numpy's fixed order, never by BLAS (see :mod:`rgbd_eval.exact`).
+
+``compare``'s paired bootstrap draws one set of replicate weights per sequence and
+applies it to both reports' tables (the same frames of the same sequence), so a
+replicate of a metric's change is the change on the same resampled frames. The change is
+outside its interval when 0 is not between the 2.5th and 97.5th percentiles.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import zlib
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy import sparse
+from scipy.optimize import linear_sum_assignment
+
+from rgbd_eval import exact
+from rgbd_eval.metrics.frames import FloatArray, FrameTable, IntArray
+from rgbd_eval.metrics.hota import ALPHAS
+
+#: Replicates per interval (``evaluation.bootstrap_replicates``).
+DEFAULT_REPLICATES = 1000
+#: The seed of every interval (``evaluation.bootstrap_seed``) and of ``compare``'s bootstrap.
+DEFAULT_SEED = 33
+#: The coverage of every interval.
+CONFIDENCE = 0.95
+#: Replicates drawn at once (a constant: the draws must not depend on the sequence's length).
+CHUNK = 50
+#: Frame weights summed at once at most (replicates x frames): small arrays stay in the
+#: allocator's heap (large fresh ones cost page faults, more than the arithmetic).
+GROUP_WEIGHTS = 1 << 16
+
+#: The metrics that get an interval: those :func:`replicate_metrics` derives.
+INTERVAL_METRICS = (
+    "mota",
+    "motp",
+    "fp_rate",
+    "fn_rate",
+    "id_switches",
+    "recall_errors",
+    "main_tr",
+    "all_tr",
+    "idf1",
+    "hota",
+    "deta",
+    "assa",
+)
+
+_N_ALPHA = len(ALPHAS)
+#: Frame-level integer columns of every replicate, before the caller's extra columns.
+BASE_COLUMNS = (
+    "num_gt",
+    "num_tracks",
+    "num_matches",
+    "id_switches",
+    "recall_errors",
+    *(f"hota_tp_{a}" for a in range(_N_ALPHA)),
+)
+
+
+# ----------------------------------------------------------------------------- block length
+
+
+def _sum(values: FloatArray) -> float:
+    return float(np.add.reduce(values))
+
+
+def block_length(series: NDArray[np.float64] | NDArray[np.int64]) -> int:
+    """The circular block bootstrap's block length for ``series`` (see the module docstring)."""
+    x = np.asarray(series, dtype=np.float64)
+    n = len(x)
+    if n < 4:
+        return 1
+    x = x - _sum(x) / n
+    acv0 = _sum(x * x) / n
+    if acv0 <= 0.0:
+        return 1
+    kn = max(5, len(str(n)) - 1)  # max(5, floor(log10 n)), without libm
+    m_max = math.isqrt(n - 1) + 1 + kn  # ceil(sqrt n) + K_n
+    m_max = min(m_max, n - 1)
+    cv = 2.0 * math.sqrt(exact.log(float(n)) / exact.log(10.0) / n)
+    acv = np.array([acv0] + [_sum(x[k:] * x[: n - k]) / n for k in range(1, m_max + 1)])
+    small = np.abs(acv / acv0) < cv
+    m_hat = None
+    for m in range(0, m_max - kn + 1):
+        if small[m + 1 : m + kn + 1].all():
+            m_hat = m
+            break
+    big_m = m_max if m_hat is None else min(2 * max(m_hat, 1), m_max)
+    g = 0.0
+    lrv = acv0
+    for k in range(1, big_m + 1):
+        ratio = k / big_m
+        lam = 1.0 if ratio <= 0.5 else 2.0 * (1.0 - ratio)
+        g += 2.0 * lam * k * float(acv[k])
+        lrv += 2.0 * lam * float(acv[k])
+    if g == 0.0 or lrv <= 0.0:
+        return 1
+    d_cb = 4.0 / 3.0 * lrv * lrv
+    length = exact.power(2.0 * g * g / d_cb, 1.0 / 3.0) * exact.power(float(n), 1.0 / 3.0)
+    b_max = math.ceil(min(3.0 * math.sqrt(n), n / 3.0))
+    return int(max(1, min(b_max, math.floor(length + 0.5))))
+
+
+def frame_errors(table: FrameTable) -> IntArray:
+    """FN + FP + ID switches of every frame (the series the block length is chosen on)."""
+    gt = table.per_frame(table.gt_frame)
+    tracks = table.per_frame(table.track_frame)
+    matches = table.per_frame(table.match_frame)
+    switches = table.per_frame(table.match_frame[table.match_switch])
+    errors: IntArray = gt + tracks - 2 * matches + switches
+    return errors
+
+
+# ----------------------------------------------------------------------------- replicate weights
+
+
+def sequence_rng(seed: int, name: str) -> np.random.Generator:
+    """The generator of one sequence's replicates: PCG64 seeded by ``[seed, crc32(name)]``."""
+    return np.random.default_rng([int(seed), zlib.crc32(name.encode("utf-8"))])
+
+
+def _draw_starts(num_frames: int, block: int, count: int, rng: np.random.Generator) -> IntArray:
+    """``count`` replicates' block starts ``(count, ceil(n / block))``."""
+    return rng.integers(0, num_frames, size=(count, -(-num_frames // block)))
+
+
+def _weights(num_frames: int, block: int, starts: IntArray) -> FloatArray:
+    """Frame weights ``(replicates, frames)`` (integer-valued floats) of block starts.
+
+    Each block adds 1 over its frames (the last block cut so that a replicate has
+    ``num_frames``), counted on a doubled axis by differences and a cumulative sum, then
+    folded back (the wrap at the end).
+    """
+    n, (count, k) = num_frames, starts.shape
+    lengths = np.full(k, block, dtype=np.int64)
+    lengths[-1] = n - (k - 1) * block
+    base = (np.arange(count, dtype=np.int64) * 2 * n)[:, None]
+    size = count * 2 * n
+    steps = np.bincount((starts + base).ravel(), minlength=size)
+    steps -= np.bincount((starts + lengths[None, :] + base).ravel(), minlength=size)
+    doubled = np.cumsum(steps.reshape(count, 2 * n), axis=1, dtype=np.float64)
+    out: FloatArray = doubled[:, :n]
+    out += doubled[:, n:]
+    return out
+
+
+def weights(num_frames: int, block: int, count: int, rng: np.random.Generator) -> FloatArray:
+    """``count`` replicates' frame weights ``(count, num_frames)`` (integer-valued floats)."""
+    if num_frames == 0:
+        return np.zeros((count, 0))
+    block = max(1, min(block, num_frames))
+    return _weights(num_frames, block, _draw_starts(num_frames, block, count, rng))
+
+
+def weight_chunks(
+    num_frames: int, block: int, replicates: int, rng: np.random.Generator
+) -> Iterator[FloatArray]:
+    """The replicates' weights, drawn :data:`CHUNK` replicates at a time (so the draws do
+    not depend on the grouping), in groups of at most :data:`GROUP_WEIGHTS` weights."""
+    if num_frames == 0:
+        yield np.zeros((replicates, 0))
+        return
+    block = max(1, min(block, num_frames))
+    per_group = max(1, GROUP_WEIGHTS // num_frames // CHUNK)
+    done = 0
+    while done < replicates:
+        starts = []
+        for _ in range(per_group):
+            if done == replicates:
+                break
+            count = min(CHUNK, replicates - done)
+            starts.append(_draw_starts(num_frames, block, count, rng))
+            done += count
+        yield _weights(num_frames, block, np.concatenate(starts, axis=0))
+
+
+# ----------------------------------------------------------------------------- replicate sums
+
+
+@dataclass(frozen=True, eq=False)
+class Replicates:
+    """Summable sums of ``B`` replicates of one or more sequences.
+
+    ``ints`` holds the frame-level integer counts ``(B, K)`` named by ``columns``;
+    ``similarity`` the MOTP numerator, ``main_tr`` Main Tr.'s matches, ``idtp`` IDF1's
+    identity true positives and ``hota_ass`` HOTA's association sums ``(B, 19)``.
+    """
+
+    columns: tuple[str, ...]
+    ints: FloatArray
+    similarity: FloatArray
+    main_tr: FloatArray
+    idtp: FloatArray
+    hota_ass: FloatArray
+    block_lengths: tuple[int, ...] = field(default=())
+
+    def column(self, name: str) -> FloatArray:
+        return self.ints[:, self.columns.index(name)]
+
+    def __add__(self, other: Replicates) -> Replicates:
+        if self.columns != other.columns or len(self.ints) != len(other.ints):
+            raise ValueError("replicates of different columns or counts cannot be added")
+        return Replicates(
+            self.columns,
+            self.ints + other.ints,
+            self.similarity + other.similarity,
+            self.main_tr + other.main_tr,
+            self.idtp + other.idtp,
+            self.hota_ass + other.hota_ass,
+            self.block_lengths + other.block_lengths,
+        )
+
+
+#: Parts of IDF1's pair graph with at most this many assignments are solved by trying
+#: them all (at once for every replicate); larger ones by the Hungarian algorithm.
+EXHAUSTIVE = 720
+
+
+class _AssignmentPart:
+    """One connected part of IDF1's pair graph, as columns ``pairs`` of the pair counts.
+
+    A part with one ground-truth id or one track id is solved by its largest count, a small
+    one by trying every assignment of its rows (the smaller side) to distinct columns, the
+    others by a Hungarian assignment per replicate. Counts are non-negative, so a best
+    assignment gives every row of the smaller side a column.
+    """
+
+    def __init__(self, pairs: IntArray, rows: IntArray, cols: IntArray) -> None:
+        self.pairs = pairs
+        row_ids, rows = np.unique(rows, return_inverse=True)
+        col_ids, cols = np.unique(cols, return_inverse=True)
+        shape = (len(row_ids), len(col_ids))
+        if shape[0] > shape[1]:  # rows <= columns: the solver then returns rows 0, 1, ...
+            rows, cols, shape = cols, rows, (shape[1], shape[0])
+        self.rows, self.cols, self.shape = rows.ravel(), cols.ravel(), shape
+        self.choices: IntArray | None = None
+        if shape[0] > 1 and math.perm(shape[1], shape[0]) <= EXHAUSTIVE:
+            self.choices = np.array(list(itertools.permutations(range(shape[1]), shape[0])))
+
+    def best(self, counts: FloatArray) -> FloatArray:
+        """The best assignment's total of every replicate (columns of ``counts``)."""
+        values = counts[self.pairs]
+        if self.shape[0] == 1:
+            star: FloatArray = values.max(axis=0)
+            return star
+        count = values.shape[1]
+        dense = np.zeros((count, *self.shape))
+        dense[:, self.rows, self.cols] = values.T
+        rows = np.arange(self.shape[0])
+        if self.choices is not None:
+            tried = dense[:, rows[None, :], self.choices].sum(axis=2)  # (replicates, choices)
+            exhaustive: FloatArray = tried.max(axis=1)
+            return exhaustive
+        picked = np.stack([linear_sum_assignment(m, maximize=True)[1] for m in dense])
+        out: FloatArray = dense[np.arange(count)[:, None], rows[None, :], picked].sum(axis=1)
+        return out
+
+
+def _assignment_parts(rows: IntArray, cols: IntArray) -> list[_AssignmentPart]:
+    """The connected parts of the bipartite graph of pairs ``(rows[i], cols[i])``."""
+    if not len(rows):
+        return []
+    num_rows = int(rows.max()) + 1
+    parent = list(range(num_rows + int(cols.max()) + 1))
+
+    def root(node: int) -> int:
+        while parent[node] != node:
+            parent[node] = parent[parent[node]]
+            node = parent[node]
+        return node
+
+    for r, c in zip(rows.tolist(), cols.tolist(), strict=True):
+        a, b = root(r), root(num_rows + c)
+        if a != b:
+            parent[max(a, b)] = min(a, b)
+    part_of = np.array([root(r) for r in rows.tolist()])
+    return [
+        _AssignmentPart(np.flatnonzero(part_of == p), rows[part_of == p], cols[part_of == p])
+        for p in np.unique(part_of)
+    ]
+
+
+class _Design:
+    """Columns of per-frame event counts: ``matrix @ W.T`` sums them for every replicate."""
+
+    def __init__(self, num_frames: int) -> None:
+        self.num_frames = num_frames
+        self.rows: list[IntArray] = []
+        self.cols: list[IntArray] = []
+        self.data: list[FloatArray] = []
+        self.width = 0
+
+    def add(self, frames: IntArray, columns: IntArray | int, width: int) -> slice:
+        """Count each event ``(frames[i], columns[i])`` in its column of a new group."""
+        frames = np.asarray(frames, dtype=np.int64)
+        self.rows.append(frames)
+        if isinstance(columns, int):
+            self.cols.append(np.full(len(frames), self.width + columns, dtype=np.int64))
+        else:
+            self.cols.append(self.width + np.asarray(columns, dtype=np.int64))
+        self.data.append(np.ones(len(frames)))
+        out = slice(self.width, self.width + width)
+        self.width += width
+        return out
+
+    def add_series(self, values: IntArray) -> slice:
+        """Columns holding integers per frame: ``values`` is ``(columns, frames)``."""
+        values = np.asarray(values, dtype=np.int64).reshape(-1, self.num_frames)
+        cols, frames = np.nonzero(values)
+        self.rows.append(frames.astype(np.int64))
+        self.cols.append(self.width + cols.astype(np.int64))
+        self.data.append(values[cols, frames].astype(np.float64))
+        out = slice(self.width, self.width + len(values))
+        self.width += len(values)
+        return out
+
+    def matrix(self) -> sparse.csr_matrix:
+        """The transposed design ``(columns, frames)``; repeated events add up (exact)."""
+        rows = np.concatenate(self.rows) if self.rows else np.zeros(0, dtype=np.int64)
+        cols = np.concatenate(self.cols) if self.cols else np.zeros(0, dtype=np.int64)
+        data = np.concatenate(self.data) if self.data else np.zeros(0)
+        shape = (self.width, self.num_frames)
+        return sparse.coo_matrix((data, (cols, rows)), shape=shape).tocsr()
+
+
+class _SequenceSums:
+    """What one table's replicates need, prepared once: one sparse matrix of per-frame counts.
+
+    Sums are kept as ``(column, replicate)`` arrays, so that every step runs on contiguous
+    rows. Each event is counted once: ground truth and tracks per id, matches per pair,
+    HOTA's pairs by level (how many localisation thresholds their similarity reaches,
+    0..19); the totals are sums of those.
+    """
+
+    def __init__(self, table: FrameTable, extra: Mapping[str, IntArray]) -> None:
+        t = table
+        design = _Design(t.num_frames)
+        self.columns = (*BASE_COLUMNS, *extra)
+        num_tracks = max(t.num_tracks, 1)
+        self.gt_count = design.add(t.gt_frame, t.gt_index, t.num_gt_tracks)
+        self.track_count = design.add(t.track_frame, t.track_index, t.num_tracks)
+        switches = design.add(t.match_frame[t.match_switch], 0, 1)
+        recalls = design.add(t.match_frame[t.match_recall], 0, 1)
+        self.flags = slice(switches.start, recalls.stop)
+        series = np.zeros((len(extra), t.num_frames), dtype=np.int64)
+        for k, values in enumerate(extra.values()):
+            series[k] = values
+        self.extra = design.add_series(series)
+        # Main Tr.: matches per (gt, track) pair; the best track per gt.
+        keys = t.match_gt * num_tracks + t.match_track
+        pairs, inverse = np.unique(keys, return_inverse=True)
+        self.main = design.add(t.match_frame, inverse.ravel(), len(pairs))
+        self.main_gt_starts = np.unique(pairs // num_tracks, return_index=True)[1]
+        # IDF1: frames inside the gate per (gt, track) pair.
+        keys = t.potential_gt * num_tracks + t.potential_track
+        pairs, inverse = np.unique(keys, return_inverse=True)
+        self.potential = design.add(t.potential_frame, inverse.ravel(), len(pairs))
+        self.id_parts = _assignment_parts(pairs // num_tracks, pairs % num_tracks)
+        # HOTA: per pair its matches by level.
+        keys = t.hota_gt * num_tracks + t.hota_track
+        pairs, inverse = np.unique(keys, return_inverse=True)
+        self.num_hota_pairs = len(pairs)
+        column = t.hota_levels() * len(pairs) + inverse.ravel()
+        self.pair_levels = design.add(t.hota_frame, column, len(pairs) * (_N_ALPHA + 1))
+        self.hota_pair_gt = pairs // num_tracks
+        self.hota_pair_track = pairs % num_tracks
+        self.similarity = t.per_frame(t.match_frame, t.match_value).astype(np.float64)
+        self.design = design.matrix()
+
+    def chunk(self, w: FloatArray) -> tuple[FloatArray, ...]:
+        """The sums ``(replicate, ...)`` of the replicates whose frame weights are ``w``."""
+        count = len(w)
+        # Integer counts with integer weights: exact in any summation order.
+        sums = np.asarray(self.design @ w.T)  # (columns, replicates)
+        similarity = np.add.reduce(w * self.similarity[None, :], axis=1)
+        gt_count, track_count = sums[self.gt_count], sums[self.track_count]
+        main = sums[self.main]
+        by_level = sums[self.pair_levels].reshape(_N_ALPHA + 1, self.num_hota_pairs, count)
+        ints = np.zeros((len(self.columns), count))
+        ints[0] = gt_count.sum(axis=0)
+        ints[1] = track_count.sum(axis=0)
+        ints[2] = main.sum(axis=0)
+        ints[3:5] = sums[self.flags]
+        # HOTA's TP at threshold a: the pairs of level > a.
+        ints[5 : 5 + _N_ALPHA] = np.cumsum(by_level.sum(axis=1)[:0:-1], axis=0)[::-1]
+        ints[5 + _N_ALPHA :] = sums[self.extra]
+        main_tr = np.zeros(count)
+        if len(main):
+            main_tr = np.maximum.reduceat(main, self.main_gt_starts, axis=0).sum(axis=0)
+        potential = sums[self.potential]
+        idtp = np.zeros(count)
+        for part in self.id_parts:
+            idtp += part.best(potential)
+        ass = self._hota_ass(by_level, gt_count, track_count)
+        return ints.T, similarity, main_tr, idtp, ass.T
+
+    def _hota_ass(
+        self, by_level: FloatArray, gt_count: FloatArray, track_count: FloatArray
+    ) -> FloatArray:
+        count = by_level.shape[2]
+        ass = np.zeros((_N_ALPHA, count))
+        if not self.num_hota_pairs:
+            return ass
+        both = gt_count[self.hota_pair_gt] + track_count[self.hota_pair_track]
+        reach = np.zeros((self.num_hota_pairs, count))
+        # One threshold at a time, from the highest: small arrays, no large temporaries.
+        for a in range(_N_ALPHA - 1, -1, -1):
+            reach += by_level[a + 1]  # the matches of level > a
+            ass[a] = np.add.reduce(reach * reach / np.maximum(1.0, both - reach), axis=0)
+        return ass
+
+
+def replicates(
+    table: FrameTable,
+    name: str,
+    count: int = DEFAULT_REPLICATES,
+    seed: int = DEFAULT_SEED,
+    extra: Mapping[str, IntArray] | None = None,
+    block: int | None = None,
+) -> Replicates:
+    """``count`` replicates of one sequence (block length by :func:`block_length` unless given).
+
+    ``extra`` adds per-frame integer series (``num_frames`` long) as further columns.
+    """
+    sums = _SequenceSums(table, extra or {})
+    length = block_length(frame_errors(table)) if block is None else block
+    parts = [
+        sums.chunk(w)
+        for w in weight_chunks(table.num_frames, length, count, sequence_rng(seed, name))
+    ]
+    return _assemble(sums.columns, parts, count, (length,))
+
+
+def paired_replicates(
+    tables: tuple[FrameTable, FrameTable],
+    name: str,
+    block: int,
+    count: int = DEFAULT_REPLICATES,
+    seed: int = DEFAULT_SEED,
+) -> tuple[Replicates, Replicates]:
+    """Replicates of two tables of the same frames on the same draws (``compare``)."""
+    if tables[0].num_frames != tables[1].num_frames:
+        raise ValueError(
+            f"sequence {name!r}: {tables[0].num_frames} frames against {tables[1].num_frames}"
+        )
+    first, second = _SequenceSums(tables[0], {}), _SequenceSums(tables[1], {})
+    parts_a, parts_b = [], []
+    for w in weight_chunks(tables[0].num_frames, block, count, sequence_rng(seed, name)):
+        parts_a.append(first.chunk(w))
+        parts_b.append(second.chunk(w))
+    return (
+        _assemble(first.columns, parts_a, count, (block,)),
+        _assemble(second.columns, parts_b, count, (block,)),
+    )
+
+
+def _assemble(
+    columns: tuple[str, ...],
+    parts: Sequence[tuple[FloatArray, ...]],
+    count: int,
+    blocks: tuple[int, ...],
+) -> Replicates:
+    if not parts:
+        return Replicates(
+            columns,
+            np.zeros((count, len(columns))),
+            np.zeros(count),
+            np.zeros(count),
+            np.zeros(count),
+            np.zeros((count, _N_ALPHA)),
+            blocks,
+        )
+    ints, sim, main, idtp, ass = (np.concatenate(p, axis=0) for p in zip(*parts, strict=True))
+    return Replicates(columns, ints, sim, main, idtp, ass, blocks)
+
+
+# ----------------------------------------------------------------------------- metrics, intervals
+
+
+def _ratio(numerator: FloatArray, denominator: FloatArray) -> FloatArray:
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(
+            denominator > 0, numerator / np.where(denominator > 0, denominator, 1), np.nan
+        )
+
+
+def replicate_metrics(r: Replicates) -> dict[str, FloatArray]:
+    """:data:`INTERVAL_METRICS` of every replicate (NaN where a denominator is 0).
+
+    The formulas of :func:`rgbd_eval.metrics.counts.summarize` and
+    :meth:`rgbd_eval.metrics.hota.HotaCounts.summary`, on arrays.
+    """
+    gt, tracks = r.column("num_gt"), r.column("num_tracks")
+    matches, switches = r.column("num_matches"), r.column("id_switches")
+    fn, fp = gt - matches, tracks - matches
+    tp = r.ints[:, [r.columns.index(f"hota_tp_{a}") for a in range(_N_ALPHA)]]
+    det = tp / np.maximum(1.0, gt[:, None] + tracks[:, None] - tp)
+    ass = r.hota_ass / np.maximum(1.0, tp)
+    scored = (gt + tracks) > 0
+    nan = np.full(len(gt), np.nan)
+    return {
+        "mota": 1.0 - _ratio(fn + fp + switches, gt),
+        "motp": _ratio(r.similarity, matches),
+        "fp_rate": _ratio(fp, gt),
+        "fn_rate": _ratio(fn, gt),
+        "id_switches": switches,
+        "recall_errors": r.column("recall_errors"),
+        "main_tr": _ratio(r.main_tr, gt),
+        "all_tr": _ratio(matches, gt),
+        "idf1": _ratio(2.0 * r.idtp, gt + tracks),
+        "hota": np.where(scored, np.sqrt(det * ass).mean(axis=1), nan),
+        "deta": np.where(scored, det.mean(axis=1), nan),
+        "assa": np.where(scored, ass.mean(axis=1), nan),
+    }
+
+
+def interval(values: FloatArray) -> tuple[float, float] | None:
+    """The :data:`CONFIDENCE` percentile interval of replicate values (None if all are NaN).
+
+    The ends are order statistics (numpy's ``inverted_cdf`` quantiles): of ``N`` values
+    sorted, the ``ceil(0.025 N)``-th and the ``ceil(0.975 N)``-th.
+    """
+    finite = np.sort(values[~np.isnan(values)])
+    n = len(finite)
+    if not n:
+        return None
+    tail = (1.0 - CONFIDENCE) / 2.0
+    lo = max(1, math.ceil(round(tail * n, 9)))
+    hi = max(1, math.ceil(round((1.0 - tail) * n, 9)))
+    return float(finite[lo - 1]), float(finite[hi - 1])
+
+
+def intervals_of(values: Mapping[str, FloatArray]) -> dict[str, tuple[float, float] | None]:
+    """:func:`interval` of each series, sorted all at once."""
+    if not values:
+        return {}
+    names = list(values)
+    ordered = np.sort(np.stack([values[k] for k in names]), axis=1)  # NaN last
+    finite = (~np.isnan(ordered)).sum(axis=1)
+    tail = (1.0 - CONFIDENCE) / 2.0
+    out: dict[str, tuple[float, float] | None] = {}
+    for name, row, n in zip(names, ordered, finite.tolist(), strict=True):
+        if not n:
+            out[name] = None
+            continue
+        lo = max(1, math.ceil(round(tail * n, 9)))
+        hi = max(1, math.ceil(round((1.0 - tail) * n, 9)))
+        out[name] = (float(row[lo - 1]), float(row[hi - 1]))
+    return out
+
+
+def intervals(r: Replicates) -> dict[str, tuple[float, float] | None]:
+    """Every :data:`INTERVAL_METRICS` interval of a set of replicates."""
+    return intervals_of(replicate_metrics(r))
+
+
+def total_replicates(items: Sequence[Replicates]) -> Replicates:
+    """The replicates of several sequences summed (the overall row)."""
+    result = items[0]
+    for item in items[1:]:
+        result = result + item
+    return result

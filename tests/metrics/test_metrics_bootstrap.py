@@ -1,0 +1,127 @@
+"""The block bootstrap: its variance against the known one, determinism, exact replicates."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+from metrics_builders import gt, track
+
+from rgbd_eval.config import EvaluationConfig
+from rgbd_eval.io.tracks import align, read_mot_gt, read_mot_tracks
+from rgbd_eval.metrics import bootstrap as boot
+from rgbd_eval.metrics import evaluate_sequence, summarize
+from rgbd_eval.metrics.frames import FrameTable
+
+PEOPLE = 10
+
+
+def _table(misses: np.ndarray) -> FrameTable:
+    """A sequence of ``len(misses)`` frames with 10 people each, ``misses[f]`` of them missed
+    in frame f (the others matched by a track of their own id; no false positive)."""
+    gts, tracks = [], []
+    for missed in misses.tolist():
+        boxes = [(30.0 * k, 0.0, 10.0, 10.0) for k in range(PEOPLE)]
+        gts.append([gt(k, box) for k, box in enumerate(boxes)])
+        tracks.append([track(k, box) for k, box in enumerate(boxes) if k >= missed])
+    return evaluate_sequence(gts, tracks, EvaluationConfig()).table
+
+
+def _known_variance(x: np.ndarray, block: int) -> float:
+    """The circular block bootstrap's variance of the mean of ``x`` (n a multiple of
+    ``block``): ``(1/n) sum_{|h|<L} (1 - |h|/L) c(h)``, ``c`` the circular autocovariance."""
+    n = len(x)
+    d = x - x.mean()
+    c = [float(np.mean(d * np.roll(d, -h))) for h in range(block)]
+    return (c[0] + 2 * sum((1 - h / block) * c[h] for h in range(1, block))) / n
+
+
+def _fn_rate_variance(table: FrameTable, block: int) -> float:
+    reps = boot.replicates(table, "synthetic", count=4000, block=block)
+    return float(np.var(boot.replicate_metrics(reps)["fn_rate"]))
+
+
+def test_independent_frames_the_variance_of_the_ordinary_bootstrap() -> None:
+    rng = np.random.default_rng(1)
+    misses = rng.binomial(PEOPLE, 0.3, size=400)
+    # FN rate = mean over frames of misses / 10 (10 people per frame): with blocks of one
+    # frame the bootstrap's variance is the sample variance over n, here about 5.2e-5.
+    known = _known_variance(misses / PEOPLE, 1)
+    assert known == pytest.approx(np.var(misses / PEOPLE) / 400)
+    assert _fn_rate_variance(_table(misses), 1) == pytest.approx(known, rel=0.1)
+
+
+def test_correlated_frames_need_blocks() -> None:
+    rng = np.random.default_rng(2)
+    # Runs of 20 frames with the same number of misses: strongly correlated frames.
+    misses = np.repeat(rng.binomial(PEOPLE, 0.3, size=20), 20)
+    table = _table(misses)
+    blocked = _fn_rate_variance(table, 20)
+    assert blocked == pytest.approx(_known_variance(misses / PEOPLE, 20), rel=0.1)
+    # One-frame blocks take the frames as independent: far too small an interval.
+    assert _fn_rate_variance(table, 1) < 0.2 * blocked
+    # The automatic rule sees the correlation; white noise gets short blocks.
+    assert boot.block_length(misses) >= 10
+    assert boot.block_length(rng.binomial(PEOPLE, 0.3, size=400)) <= 3
+
+
+def test_weights_resample_every_frame_count() -> None:
+    rng = np.random.default_rng(3)
+    for n, block in ((150, 19), (71, 6), (10, 3), (5, 5), (7, 1)):
+        w = boot.weights(n, block, 40, rng)
+        assert w.shape == (40, n) and (w.sum(axis=1) == n).all()
+    # Circular blocks of 5 of 10 frames starting at 8 (frames 8, 9, 0, 1, 2: wrapped) and 0.
+    starts = np.array([[8, 0]])
+    assert boot._weights(10, 5, starts).tolist() == [[2, 2, 2, 1, 1, 0, 0, 0, 1, 1]]
+
+
+TUD = Path(pytest.importorskip("motmetrics").__file__).parent / "data"
+
+
+def _tud(name: str) -> tuple[FrameTable, dict]:
+    aligned = align(read_mot_gt(TUD / name / "gt.txt"), read_mot_tracks(TUD / name / "test.txt"), 0)
+    scores = evaluate_sequence(aligned.gt, aligned.tracks, EvaluationConfig())
+    return scores.table, summarize(scores.counts)
+
+
+@pytest.mark.parametrize("name", ["TUD-Campus", "TUD-Stadtmitte"])
+def test_a_replicate_of_every_frame_once_is_the_score(name: str) -> None:
+    table, summary = _tud(name)
+    sums = boot._SequenceSums(table, {})
+    one = boot._assemble(sums.columns, [sums.chunk(np.ones((1, table.num_frames)))], 1, (1,))
+    # IDF1's assignment and HOTA's association recomputed from the per-frame table give the
+    # scorer's values: integers exactly, the MOTP similarity sum to the last bits.
+    for metric, values in boot.replicate_metrics(one).items():
+        assert values[0] == pytest.approx(summary[metric], abs=1e-12), metric
+
+
+def test_intervals_are_deterministic_for_a_seed() -> None:
+    table, summary = _tud("TUD-Campus")
+    first = boot.intervals(boot.replicates(table, "TUD-Campus"))
+    assert boot.intervals(boot.replicates(table, "TUD-Campus")) == first
+    other = boot.intervals(boot.replicates(table, "TUD-Campus", seed=7))
+    assert other != first
+    lo, hi = first["mota"] or (0.0, 0.0)
+    assert lo < float(summary["mota"] or 0.0) < hi
+
+
+def test_small_assignments_tried_in_full_equal_the_hungarian() -> None:
+    rng = np.random.default_rng(4)
+    rows = np.repeat(np.arange(3), 4)
+    cols = np.tile(np.arange(4), 3)
+    part = boot._AssignmentPart(np.arange(12), rows, cols)
+    assert part.choices is not None  # 4 * 3 * 2 = 24 assignments, tried at once
+    counts = rng.integers(0, 30, size=(12, 200)).astype(float)
+    tried = part.best(counts)
+    part.choices = None  # the Hungarian path
+    assert (part.best(counts) == tried).all()
+
+
+def test_the_frame_table_saves_and_loads() -> None:
+    table, _ = _tud("TUD-Stadtmitte")
+    back = FrameTable.load(table.save())
+    for name in ("gt_frame", "match_value", "match_switch", "hota_similarity", "track_ids"):
+        assert np.array_equal(getattr(back, name), getattr(table, name))
+    with pytest.raises(ValueError, match="not a frames table"):
+        FrameTable.load(b"not a zip")
