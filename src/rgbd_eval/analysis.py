@@ -147,16 +147,22 @@ class Analysis:
 def _band_intervals(
     replicates: boot.Replicates | None, breakdowns: Sequence[bd.Breakdown]
 ) -> dict[tuple[str, str], dict[str, Interval]]:
+    """The intervals of every band that has ground truth, all sorted at once."""
     if replicates is None:
         return {}
-    columns = {name: replicates.column(name) for name in replicates.columns if "/" in name}
-    out: dict[tuple[str, str], dict[str, Interval]] = {}
+    values: dict[str, Any] = {}
     for b in breakdowns:
         if not b.available:
             continue
         for band in b.bands:
-            values = bd.band_replicate_metrics(columns, b.kind, band.label, b.with_fp)
-            out[b.kind, band.label] = boot.intervals_of(values)
+            if band.counts.num_gt == 0:
+                continue
+            metrics = bd.band_replicate_metrics(replicates.column, b.kind, band.label, b.with_fp)
+            values.update({f"{b.kind}/{band.label}/{k}": v for k, v in metrics.items()})
+    out: dict[tuple[str, str], dict[str, Interval]] = {}
+    for key, interval in boot.intervals_of(values).items():
+        kind, label, metric = key.split("/")
+        out.setdefault((kind, label), {})[metric] = interval
     return out
 
 

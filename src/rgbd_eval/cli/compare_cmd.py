@@ -58,7 +58,8 @@ def compare(
     base_report, cur_report = load_report(baseline), load_report(current)
     intervals, missing = paired_intervals(baseline, base_report, current, cur_report)
     comparison = compare_reports(base_report, cur_report, tolerances, intervals, significance)
-    comparison = replace(comparison, notes=(*comparison.notes, *missing))
+    if significance:  # where there is no interval, say so: those metrics keep their tolerance
+        comparison = replace(comparison, notes=(*comparison.notes, *missing))
     table = Table(title=f"{baseline} -> {current}", title_justify="left")
     for i, head in enumerate(HEADER):
         table.add_column(head, justify="left" if i < 2 else "right")
@@ -75,7 +76,10 @@ def compare(
     for change in comparison.config_changes:
         console.print(f"config: {change}")
     for note in comparison.notes:
-        typer.echo(f"note: {one_line(note)}", err=True)
+        if note in missing:  # how the gate works, with the table: not a problem of the input
+            console.print(f"note: {one_line(note)}", markup=False, highlight=False)
+        else:
+            typer.echo(f"note: {one_line(note)}", err=True)
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison), "compare")
     if html_file is not None:

@@ -160,22 +160,14 @@ def _draw_starts(num_frames: int, block: int, count: int, rng: np.random.Generat
 
 
 def _weights(num_frames: int, block: int, starts: IntArray) -> FloatArray:
-    """Frame weights ``(replicates, frames)`` (integer-valued floats) of block starts.
-
-    Each block adds 1 over its frames (the last block cut so that a replicate has
-    ``num_frames``), counted on a doubled axis by differences and a cumulative sum, then
-    folded back (the wrap at the end).
-    """
+    """Frame weights ``(replicates, frames)`` (integer-valued floats) of block starts: each
+    block's frames (wrapping at the end), the first ``num_frames`` of a replicate, counted."""
     n, (count, k) = num_frames, starts.shape
-    lengths = np.full(k, block, dtype=np.int64)
-    lengths[-1] = n - (k - 1) * block
-    base = (np.arange(count, dtype=np.int64) * 2 * n)[:, None]
-    size = count * 2 * n
-    steps = np.bincount((starts + base).ravel(), minlength=size)
-    steps -= np.bincount((starts + lengths[None, :] + base).ravel(), minlength=size)
-    doubled = np.cumsum(steps.reshape(count, 2 * n), axis=1, dtype=np.float64)
-    out: FloatArray = doubled[:, :n]
-    out += doubled[:, n:]
+    frames = (starts[:, :, None] + np.arange(block)[None, None, :]).reshape(count, k * block)
+    frames = frames[:, :n] % n
+    frames += (np.arange(count, dtype=np.int64) * n)[:, None]
+    counts = np.bincount(frames.ravel(), minlength=count * n)
+    out: FloatArray = counts.reshape(count, n).astype(np.float64)
     return out
 
 
@@ -228,9 +220,14 @@ class Replicates:
     idtp: FloatArray
     hota_ass: FloatArray
     block_lengths: tuple[int, ...] = field(default=())
+    _index: dict[str, int] = field(default_factory=dict, repr=False, compare=False)
 
     def column(self, name: str) -> FloatArray:
-        return self.ints[:, self.columns.index(name)]
+        """The replicates' sums of one frame-level column."""
+        index = self._index.get(name)
+        if index is None:
+            index = self._index.setdefault(name, self.columns.index(name))
+        return self.ints[:, index]
 
     def __add__(self, other: Replicates) -> Replicates:
         if self.columns != other.columns or len(self.ints) != len(other.ints):
@@ -340,7 +337,7 @@ class _Design:
 
     def add_series(self, values: IntArray) -> slice:
         """Columns holding integers per frame: ``values`` is ``(columns, frames)``."""
-        values = np.asarray(values, dtype=np.int64).reshape(-1, self.num_frames)
+        values = np.asarray(values, dtype=np.int64).reshape(len(values), self.num_frames)
         cols, frames = np.nonzero(values)
         self.rows.append(frames.astype(np.int64))
         self.cols.append(self.width + cols.astype(np.int64))

@@ -51,7 +51,7 @@ match before (else the match is an id switch). Recovery rate per gap length.
 from __future__ import annotations
 
 import itertools
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
@@ -652,13 +652,14 @@ def band_series(b: SequenceBreakdowns) -> dict[str, IntArray]:
 
 
 def band_replicate_metrics(
-    columns: Mapping[str, FloatArray], kind: str, label: str, with_fp: bool
+    column: Callable[[str], FloatArray], kind: str, label: str, with_fp: bool
 ) -> dict[str, FloatArray]:
-    """MOTA, FN, FP and id-switch rates of one band per replicate (NaN where GT is 0)."""
-    gt = columns[f"{kind}/{label}/num_gt"]
-    matches = columns[f"{kind}/{label}/num_matches"]
-    fp = columns[f"{kind}/{label}/fp"] if with_fp else np.zeros_like(gt)
-    switches = columns[f"{kind}/{label}/id_switches"]
+    """MOTA, FN, FP and id-switch rates of one band per replicate (NaN where GT is 0);
+    ``column(name)`` gives the replicates' sums of the column ``kind/label/field``."""
+    gt = column(f"{kind}/{label}/num_gt")
+    matches = column(f"{kind}/{label}/num_matches")
+    fp = column(f"{kind}/{label}/fp") if with_fp else np.zeros_like(gt)
+    switches = column(f"{kind}/{label}/id_switches")
     with np.errstate(divide="ignore", invalid="ignore"):
         safe = np.where(gt > 0, gt, 1.0)
         out = {

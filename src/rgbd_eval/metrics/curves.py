@@ -63,10 +63,12 @@ def thresholds(values: Sequence[float], points: int = DEFAULT_POINTS) -> list[fl
 
 
 def keep_above(frames: Frames, threshold: float) -> list[list[TrackOutput]]:
-    """The track instances of confidence ``>= threshold`` (all those without a confidence)."""
-    return [
-        [t for t in frame if t.confidence is None or t.confidence >= threshold] for frame in frames
-    ]
+    """The track instances of confidence ``>= threshold`` (all those without a finite one)."""
+    return [[t for t in frame if _kept(t.confidence, threshold)] for frame in frames]
+
+
+def _kept(confidence: float | None, threshold: float) -> bool:
+    return confidence is None or not math.isfinite(confidence) or confidence >= threshold
 
 
 @dataclass(frozen=True)

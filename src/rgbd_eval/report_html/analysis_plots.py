@@ -85,8 +85,9 @@ def breakdown_panels(
     FP counted)``; the bars carry their 95 % intervals as error bars, the ticks the GT.
     """
     plt = pyplot()
+    height = 2.5 * len(rows) + 0.3  # inches; margins below fixed in inches too
     fig, axes = plt.subplots(
-        len(rows), len(BAND_PANELS), figsize=(10.5, 2.4 * len(rows)), dpi=DPI, squeeze=False
+        len(rows), len(BAND_PANELS), figsize=(10.5, height), dpi=DPI, squeeze=False
     )
     for r, (title, labels, metrics, intervals, gt, with_fp) in enumerate(rows):
         xs = np.arange(len(labels))
@@ -129,7 +130,9 @@ def breakdown_panels(
                 fontsize=8.5,
                 loc="left" if c == 0 else "center",
             )
-    fig.subplots_adjust(left=0.05, right=0.99, top=0.93, bottom=0.1, hspace=0.75, wspace=0.25)
+    fig.subplots_adjust(
+        left=0.05, right=0.99, top=1 - 0.3 / height, bottom=0.6 / height, hspace=0.6, wspace=0.25
+    )
     return figure_png(fig)
 
 

@@ -50,7 +50,8 @@ class AnalysisView:
     worst: tuple[tuple[str, ...], ...]
     bootstrap: str
     interval_header: tuple[str, ...]
-    interval_rows: tuple[tuple[str, ...], ...]
+    #: Per sequence: name, block length, and per metric (value, its interval) as text.
+    interval_rows: tuple[tuple[str, str, tuple[tuple[str, str], ...]], ...]
     interval_figure: str | None
     summary_title: str
     breakdowns: tuple[BreakdownView, ...]
@@ -136,6 +137,12 @@ def _curve_view(analysis: an.Analysis) -> CurveView | None:
     return CurveView(True, "", rows, best, data_uri(figure))
 
 
+def _split(text: str) -> tuple[str, str]:
+    """``72.5% [54.7, 86.8]`` -> ``("72.5%", "[54.7, 86.8]")``."""
+    value, _, interval = text.partition(" [")
+    return value, f"[{interval}" if interval else ""
+
+
 def analysis_view(analysis: an.Analysis, report: Mapping[str, Any]) -> AnalysisView:
     """Tables and figures of ``analysis``; ``report`` gives the metrics (``report.json``)."""
     from rgbd_eval.report import sequence_summaries
@@ -155,15 +162,19 @@ def analysis_view(analysis: an.Analysis, report: Mapping[str, Any]) -> AnalysisV
         for w in analysis.worst
     )
     parts = [*analysis.sequences, *([analysis.overall] if analysis.overall else [])]
-    interval_rows: tuple[tuple[str, ...], ...] = ()
+    interval_rows: tuple[tuple[str, str, tuple[tuple[str, str], ...]], ...] = ()
     figure = None
     if analysis.replicates > 0 and parts:
         interval_rows = tuple(
             (
                 p.name,
                 "-" if p.block_length is None else str(p.block_length),
-                *(
-                    an.interval_text(k, (metrics.get(p.name) or {}).get(k), p.intervals.get(k), g)
+                tuple(
+                    _split(
+                        an.interval_text(
+                            k, (metrics.get(p.name) or {}).get(k), p.intervals.get(k), g
+                        )
+                    )
                     for k, _ in an.INTERVAL_COLUMNS
                 ),
             )
