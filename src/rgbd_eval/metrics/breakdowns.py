@@ -431,7 +431,9 @@ def visibility_breakdown(table: FrameTable, inst: Instances) -> Breakdown:
     """Counts by the ground truth's visible share (FP-free)."""
     if len(inst.gt_visibility) and (inst.gt_visibility == 1.0).all():
         return not_available(
-            VISIBILITY, "every ground-truth instance is 100 % visible: no visibility annotated"
+            VISIBILITY,
+            "every ground-truth instance is 100 % visible (ground truth without a visibility, "
+            "MOT15's, reads as 100 %)",
         )
     gt_band = np.searchsorted(np.array(VISIBILITY_EDGES), inst.gt_visibility, side="right")
     return _bands(VISIBILITY, VISIBILITY_LABELS, table, inst, gt_band.astype(np.int64), None, False)
