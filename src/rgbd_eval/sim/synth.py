@@ -119,6 +119,7 @@ def synthesize(
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     start = time.perf_counter()
     truth: list[GroundTruthObject] = []
+    annotated: list[tuple[int, int]] = []  # every frame, people in view or not
     with RecordingWriter(
         out, container=kind, options=stream_options(scenario), overwrite=overwrite
     ) as w:
@@ -129,10 +130,11 @@ def synthesize(
             for k, sensor in enumerate(extra):
                 sensor.write(w, sim.scene_view(f.index, k))
             truth.extend(f.ground_truth)
+            annotated.append((f.index, f.stamp_ns))
             if progress is not None:
                 progress(f.index + 1, total)
     csv_path = ground_truth_path(out)
-    write_csv(csv_path, truth)
+    write_csv(csv_path, truth, annotated)
     elapsed = time.perf_counter() - start
     return SynthResult(out, csv_path, total, len(truth), elapsed, out.stat().st_size)
 
