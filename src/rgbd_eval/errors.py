@@ -79,13 +79,16 @@ class ConfigError(RgbdEvalError):
 
 
 class GroundTruthError(RgbdEvalError):
-    """Ground truth is missing, unreadable or contradictory."""
+    """Ground truth is missing, unreadable or contradictory (``topic``: inside a recording)."""
 
     exit_code = 5
 
-    def __init__(self, path: Path | str, message: str) -> None:
+    def __init__(self, path: Path | str, message: str, topic: str | None = None) -> None:
         self.path = Path(path)
-        super().__init__(f"{self.path}: {message}")
+        self.topic = topic
+        self.message = message
+        where = f"{self.path}" + (f" [{topic}]" if topic else "")
+        super().__init__(f"{where}: {message}")
 
 
 class ScoringError(RgbdEvalError):

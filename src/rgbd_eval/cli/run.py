@@ -24,7 +24,7 @@ from rgbd_eval.cli.common import (
     with_threshold,
 )
 from rgbd_eval.config import RunConfig, load_config
-from rgbd_eval.errors import InputError
+from rgbd_eval.errors import GroundTruthError, InputError
 from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
@@ -145,8 +145,8 @@ def run(
     if not inputs:
         inputs = [ensure_demo()]
     recordings = expand_inputs(inputs)
-    if gt is not None and len(recordings) > 1:
-        raise InputError(
+    if gt is not None and len(recordings) > 1:  # which recording it annotates is unknown
+        raise GroundTruthError(
             gt, "--gt applies to a single recording; use <name>.gt.csv sidecars for several"
         )
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
