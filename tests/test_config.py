@@ -133,9 +133,9 @@ def test_a_changed_gating_takes_its_own_threshold(tmp_path: Path) -> None:
     ("overrides", "match"),
     [
         (["evaluation.threshold=1.5"], r"IoU threshold=1.5 must be in \(0, 1\]"),
-        (["evaluation.threshold=0"], "greater than 0"),
+        (["evaluation.threshold=0"], "greater than or equal to 0.001"),
         (["evaluation.gating=metric", "evaluation.threshold=.inf"], "finite number"),
-        (["evaluation.gating=metric", "evaluation.threshold=-1"], "greater than 0"),
+        (["evaluation.gating=metric", "evaluation.threshold=-1"], "greater than or equal to 0.001"),
     ],
 )
 def test_a_threshold_outside_its_gating_range_is_refused(overrides: list[str], match: str) -> None:

@@ -274,7 +274,8 @@ def _run_report(
     """``rgbd-eval run ARGS --out OUT``: stdout and the one sequence of report.json."""
     result = run_cli([*args, "--out", str(out)], capsys)
     assert result.code == 0, result.stderr
-    return result.stdout, json.loads((out / "report.json").read_text())["sequences"][0]
+    # warnings go to stderr (issue 28), one line each: "warning: <sequence>: ..."
+    return result.stderr, json.loads((out / "report.json").read_text())["sequences"][0]
 
 
 def test_frames_outside_the_annotated_span_are_not_scored(
@@ -284,9 +285,9 @@ def test_frames_outside_the_annotated_span_are_not_scored(
     rec = good_recording(tmp_path)
     first_two = tmp_path / "first2.csv"
     write_csv(first_two, ground_truth_objects()[:2])
-    stdout, seq = _run_report(["run", str(rec), "--gt", str(first_two)], tmp_path / "a", capsys)
+    stderr, seq = _run_report(["run", str(rec), "--gt", str(first_two)], tmp_path / "a", capsys)
     warning = "2 of 4 frames lie outside the annotated span (frames 0..1) and are not scored"
-    assert warning in " ".join(stdout.split())
+    assert warning in " ".join(stderr.split())
     assert any(warning in w for w in seq["warnings"])
     assert seq["ground_truth"]["unscored_frames"] == 2
     assert seq["ground_truth"]["scored_span"] == [0, 1]
@@ -311,9 +312,9 @@ def test_annotated_frames_matching_no_frame_are_reported(
     rec = gt_topic_recording(
         tmp_path / "fut.mcap", stamp=lambda i: T0 + i * PERIOD + (FAR_FUTURE_NS if i == 1 else 0)
     )
-    stdout, seq = _run_report(["run", str(rec)], tmp_path / "a", capsys)
+    stderr, seq = _run_report(["run", str(rec)], tmp_path / "a", capsys)
     warning = "1 of 4 annotated frames of"
-    assert warning in stdout and "match no frame of the recording" in " ".join(stdout.split())
+    assert warning in stderr and "match no frame of the recording" in " ".join(stderr.split())
     assert any(warning in w for w in seq["warnings"])
     assert seq["ground_truth"]["unmatched_frames"] == 1 and seq["counts"]["num_gt"] == 3
 
@@ -338,9 +339,9 @@ def test_some_implausible_depth_frames_are_dropped_and_reported(
         return {**fields, "is_bigendian": 1}  # the bytes stay little-endian
 
     rec = damaged_ros1(tmp_path / "half.bag", lambda i: i in (1, 2), image=swapped)
-    stdout, seq = _run_report(["run", str(rec)], tmp_path / "out", capsys)
+    stderr, seq = _run_report(["run", str(rec)], tmp_path / "out", capsys)
     warning = "2 of 4 depth frames hold implausible depth, dropped"
-    assert warning in " ".join(stdout.split())
+    assert warning in " ".join(stderr.split())
     assert any(warning in w and "frames 1, 2" in w for w in seq["warnings"])
     assert seq["scored"]
 

@@ -133,7 +133,7 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
-    from rgbd_eval.report import REPORT_FILE, run_warnings, write_run
+    from rgbd_eval.report import REPORT_FILE, sequence_warnings, write_run
     from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
@@ -192,5 +192,8 @@ def run(
             f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
             f"(machine-readable: {out_dir / 'report.json'})"
         )
-    for line in run_warnings(results):  # also in report.json: each sequence's "warnings"
-        err_console.print(line, markup=False, highlight=False, soft_wrap=True)
+    for r in results:  # also in report.json: each sequence's "warnings"
+        for w in sequence_warnings(r):
+            err_console.print(
+                f"warning: {r.name}: {w}", markup=False, highlight=False, soft_wrap=True
+            )
