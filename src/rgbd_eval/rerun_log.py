@@ -18,8 +18,8 @@ stamp). Entity paths (the README lists them too)::
     world/colour/image/tracks        scored track boxes: "id N", "occl" when occluded, FP, SW
     world/colour/image/ground_truth  ground-truth boxes: "gt N", "occl", "miss", "ign"
     world/depth                      world_T_depth_optical (depth_2, ... for more cameras)
-    world/depth/image                pinhole of the depth camera
-    world/depth/image/depth          the depth image (millimetres)
+    world/depth/image/depth          the depth image (millimetres; no pinhole, so the viewer
+                                     does not draw it in 3D over world/cloud)
     world/cloud                      depth points in the world frame, decimated, coloured
     world/detections                 detections' world positions
     world/tracks                     scored tracks at (x, y, height / 2), coloured by id
@@ -49,7 +49,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.config import RunConfig
-from rgbd_eval.errors import ExtraError, InputError, OutputError
+from rgbd_eval.errors import ExtraError, GroundTruthError, InputError, OutputError
 from rgbd_eval.io.images import depth_to_mm, encode_color_jpeg
 from rgbd_eval.metrics import FrameEvents, Match
 from rgbd_eval.metrics.selection import is_scored_track
@@ -210,7 +210,7 @@ def _per_frame(
 
 def _sequence_view(folder: Path, record: dict[str, Any], config: RunConfig, method: str) -> RunView:
     """One sequence of a run folder, checked against its recording (present, unchanged)."""
-    from rgbd_eval.io.groundtruth import load_ground_truth
+    from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
     from rgbd_eval.io.tracks import read_tracks_csv
     from rgbd_eval.pipeline import match_ground_truth, open_for
     from rgbd_eval.report import file_digest
@@ -238,8 +238,14 @@ def _sequence_view(folder: Path, record: dict[str, Any], config: RunConfig, meth
     ground_truth = None
     gt_record = record.get("ground_truth")
     if isinstance(gt_record, dict):
-        source = Path(str(gt_record.get("source")))
-        gt = load_ground_truth(source) if source.is_file() else recording.ground_truth_topic
+        source = str(gt_record.get("source"))
+        gt: GroundTruth | None
+        if Path(source).is_file():
+            gt = load_ground_truth(Path(source))
+        elif source.startswith(f"{path}:"):  # the recording's ground-truth topic
+            gt = recording.ground_truth_topic
+        else:
+            raise GroundTruthError(source, "the run's ground truth is not there (moved?)")
         if gt is not None:
             ground_truth = match_ground_truth(gt, stamps, config).frames
     return RunView(name, path, method, stamps, detections, tracks, ground_truth, events)
@@ -398,9 +404,9 @@ class _Logger:
         for name in ("fp", "fn", "id_switches"):
             self.log(f"errors/{name}", rr.SeriesLines(names=name), static=True)
 
-    def _camera(self, entity: str, stream: Stream) -> None:
+    def _camera(self, entity: str, stream: Stream, pinhole: bool = True) -> None:
         self.log(entity, _transform(self.rr, stream.pose))
-        if entity not in self.pinholes:  # intrinsics do not change within a recording
+        if pinhole and entity not in self.pinholes:  # intrinsics do not change
             self.log(f"{entity}/image", _pinhole(self.rr, stream), static=True)
             self.pinholes.add(entity)
 
@@ -424,7 +430,8 @@ class _Logger:
         for role, stream in frame.depth_streams():
             if stream.encoding != "depth":
                 continue
-            self._camera(f"world/{role}", stream)
+            # No pinhole: the viewer would draw the depth image in 3D too, over world/cloud.
+            self._camera(f"world/{role}", stream, pinhole=False)
             if colour is None and role == "depth":
                 self.path.append(stream.pose.translation)
             self.log(
@@ -432,7 +439,9 @@ class _Logger:
                 rr.DepthImage(depth_to_mm(stream.image), meter=1000.0),
             )
         positions, colours = world_cloud(frame)
-        self.log("world/cloud", rr.Points3D(positions, colors=colours, radii=0.01))
+        self.log(
+            "world/cloud", rr.Points3D(positions, colors=colours, radii=rr.Radius.ui_points(2.5))
+        )
         self._world(frame.stamp_ns, detections, tracks, gt, events)
         self._errors(events)
 
@@ -618,6 +627,8 @@ class RrdOutput:
         require_rerun()
         self.path = Path(path)
         self.owner = owner
+        if self.path.suffix != ".rrd":  # the viewer loads Rerun recordings by this suffix
+            raise OutputError(self.path, "name a .rrd file (Rerun opens recordings by suffix)")
         check_output_file(self.path, owner, inputs)
         self.staging = self.path.with_name(staging_name(self.path.name))
 
@@ -635,6 +646,26 @@ class RrdOutput:
             self.staging.unlink(missing_ok=True)
 
 
+def blueprint() -> Any:
+    """The viewer's layout: the 3D world beside the colour image with its boxes, the depth
+    image, the error counts over time and the error lines."""
+    import rerun.blueprint as rrb
+
+    return rrb.Blueprint(
+        rrb.Horizontal(
+            rrb.Spatial3DView(origin="world", name="world"),
+            rrb.Vertical(
+                rrb.Spatial2DView(origin="world/colour/image", name="colour"),
+                rrb.Spatial2DView(origin="world/depth/image", name="depth"),
+                rrb.TimeSeriesView(origin="errors", name="errors"),
+                rrb.TextLogView(origin="events", name="events"),
+            ),
+            column_shares=[3, 2],
+        ),
+        collapse_panels=True,
+    )
+
+
 def write_rrd(
     path: Path, view: RunView, config: RunConfig, progress: Progress | None = None
 ) -> None:
@@ -645,10 +676,12 @@ def write_rrd(
     stream = rr.RecordingStream("rgbd-eval", recording_id=recording_id(view))
     stream.set_log_time_enabled(False)
     try:
-        stream.save(str(path))
+        stream.save(str(path), default_blueprint=blueprint())
     except (OSError, RuntimeError, ValueError) as err:
         raise OutputError(path, f"cannot write ({err})") from err
-    stream.send_recording_name(f"{view.name} ({view.method})")
-    log_run(stream, view, open_for(view.recording, config).frames(), progress)
-    stream.flush()
-    stream.disconnect()
+    try:
+        stream.send_recording_name(f"{view.name} ({view.method})")
+        log_run(stream, view, open_for(view.recording, config).frames(), progress)
+    finally:  # the file is complete (or, after an error, the SDK lets go of it)
+        stream.flush()
+        stream.disconnect()

@@ -339,3 +339,12 @@ def test_labels_and_a_recording_without_depth(tmp_path: Path) -> None:
     mine.write_text("frame,stamp_ns,id\n")
     output = _cli("annotate", "import", str(xml), "--recording", str(rec), "-o", str(mine), code=7)
     assert "not written by `rgbd-eval annotate`" in output
+
+
+def test_a_missing_subcommand_is_one_usage_line(capsys: pytest.CaptureFixture[str]) -> None:
+    from tests.fuzz.cli import run_cli
+
+    outcome = run_cli(["annotate"], capsys)
+    assert outcome.code == 2
+    line = outcome.stderr.strip()
+    assert line.startswith("error: Missing command. (see ") and line.endswith("annotate --help)")

@@ -15,8 +15,9 @@ from rgbd_eval.cli.main import app
 
 ROOT = Path(__file__).resolve().parents[2]
 OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
-#: Flags that belong to other programs quoted in the README (pip, pytest, dask).
+#: Flags that belong to other programs quoted in the README (pip, pytest, dask, rerun, chromium).
 FOREIGN = {"--no-deps", "--upgrade", "--strict-markers", "--nworkers", "--nthreads"}
+FOREIGN |= {"--headless", "--web-viewer", "--use-angle", "--enable-unsafe-swiftshader"}
 
 
 def _options() -> dict[str, set[str]]:

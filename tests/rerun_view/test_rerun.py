@@ -76,7 +76,6 @@ def test_run_rerun_holds_the_run(run_dir: Path) -> None:
         "/world/colour/image/tracks",
         "/world/colour/image/ground_truth",
         "/world/depth",
-        "/world/depth/image",
         "/world/depth/image/depth",
         "/world/cloud",
         "/world/detections",
@@ -160,6 +159,13 @@ def test_view_refuses_a_moved_or_changed_recording(
     assert not (tmp_path / "a.rrd").exists()
     output = _cli("view", str(tmp_path), code=3)
     assert "holds no report.json" in output
+    report["sequences"][0]["path"] = str(recording)
+    report["sequences"][0]["ground_truth"]["source"] = str(tmp_path / "gone.gt.csv")
+    (folder / "report.json").write_text(json.dumps(report))
+    output = _cli("view", str(folder), "-o", str(tmp_path / "a.rrd"), code=5)
+    assert output.startswith(
+        f"error: {tmp_path / 'gone.gt.csv'}: the run's ground truth is not there"
+    )
 
 
 def test_without_the_sdk_the_options_say_how_to_get_it(
@@ -182,3 +188,5 @@ def test_rerun_takes_one_recording(recording: Path, tmp_path: Path) -> None:
     shutil.copy(recording, other)
     output = _cli("run", str(recording), str(other), "--rerun", str(tmp_path / "a.rrd"), code=2)
     assert "'--rerun'" in output and "takes one recording" in output
+    output = _cli("run", str(recording), "--rerun", str(tmp_path / "a.json"), code=7)
+    assert "name a .rrd file" in output

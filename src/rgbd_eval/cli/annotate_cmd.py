@@ -22,7 +22,7 @@ from rgbd_eval.config import load_config
 annotate = typer.Typer(
     name="annotate",
     help="Ground truth with CVAT: export a task to annotate, import CVAT's export back.",
-    no_args_is_help=True,
+    no_args_is_help=False,  # a missing subcommand is one error line (exit 2), as elsewhere
     add_completion=False,
     pretty_exceptions_enable=False,
 )
