@@ -113,6 +113,8 @@ class ImportSummary:
     has_depth: bool
     skipped: Mapping[str, int] = field(default_factory=dict)
     """Tracks left out: ``label <name>`` or a shape kind (``polygon``, ...) -> count."""
+    unplaced: tuple[int, int] | None = None
+    """(frame, id) of the first box that got no world position, if any."""
 
 
 def open_annotation_frames(path: Path, config: RunConfig) -> Recording:
@@ -536,14 +538,17 @@ def import_annotations(
     stamps = recording.frame_stamps
     objects: list[GroundTruthObject] = []
     positions = 0
+    unplaced: tuple[int, int] | None = None
 
     def add(index: int, points: _DepthPoints | None) -> None:
-        nonlocal positions
+        nonlocal positions, unplaced
         for track_id, b in sorted(per_frame[index], key=lambda item: item[0]):
             # Micrometre-rounded: x_br - x_tl of two 0.01 px values carries float noise.
             box = Box2D(*(round(v, 6) for v in (b.xtl, b.ytl, b.xbr - b.xtl, b.ybr - b.ytl)))
             world = world_position(points, box, colour) if points is not None else None
             positions += world is not None
+            if world is None and points is not None and unplaced is None:
+                unplaced = (index, track_id)
             objects.append(
                 GroundTruthObject(
                     index, stamps[index], track_id, box, world, _visibility(b), _ignored(b)
@@ -570,4 +575,5 @@ def import_annotations(
         positions=positions,
         has_depth=has_depth,
         skipped=skipped,
+        unplaced=unplaced,
     )

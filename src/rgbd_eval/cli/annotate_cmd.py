@@ -135,6 +135,12 @@ def import_(
         if summary.has_depth
         else "no depth in the recording: boxes only (metric gating will refuse it)"
     )
+    if summary.unplaced is not None:
+        frame, track = summary.unplaced
+        depth += (
+            f" (none for frame {frame} id {track} and {summary.boxes - summary.positions - 1} "
+            "more: no single surface in the torso; metric gating refuses them unless ignored)"
+        )
     console.print(
         f"{summary.output}: {summary.tracks} tracks, {summary.boxes} boxes on "
         f"{summary.frames} frames ({summary.kind}, task frame k = recording frame "
