@@ -64,7 +64,16 @@ def test_overrides_are_typed() -> None:
     [
         ({"tracker": {"bogus": 1}}, r"tracker.bogus: unknown key"),
         ({"detector": {"min_height": 2.5}}, "min_height=2.5 must be below max_height=2.3"),
-        ({"detector": {"voxel_size": 0}}, r"detector.voxel_size: Input should be greater than 0"),
+        (
+            {"detector": {"voxel_size": 0}},
+            r"detector.voxel_size: Input should be greater than or equal to 0.01 \(got 0; "
+            r"allowed: 0.01 <= voxel_size <= 0.5\)",
+        ),
+        (
+            {"tracker": {"weak_classifiers": 10**9}},
+            r"allowed: 1 <= weak_classifiers <= 2500",
+        ),
+        ({"io": {"max_sync_gap_ms": 5000}}, r"allowed: 0 < max_sync_gap_ms <= 1000"),
         ({"tracker": {"gate_distance_probability": 1.0}}, "gate_distance_probability"),
         ({"tracker": {"selectors": 300}}, "selectors=300 must not exceed weak_classifiers=250"),
         (
@@ -124,9 +133,9 @@ def test_a_changed_gating_takes_its_own_threshold(tmp_path: Path) -> None:
     ("overrides", "match"),
     [
         (["evaluation.threshold=1.5"], r"IoU threshold=1.5 must be in \(0, 1\]"),
-        (["evaluation.threshold=0"], "greater than 0"),
+        (["evaluation.threshold=0"], "greater than or equal to 0.001"),
         (["evaluation.gating=metric", "evaluation.threshold=.inf"], "finite number"),
-        (["evaluation.gating=metric", "evaluation.threshold=-1"], "greater than 0"),
+        (["evaluation.gating=metric", "evaluation.threshold=-1"], "greater than or equal to 0.001"),
     ],
 )
 def test_a_threshold_outside_its_gating_range_is_refused(overrides: list[str], match: str) -> None:

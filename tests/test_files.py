@@ -9,7 +9,7 @@ import pytest
 
 from rgbd_eval.cli.common import MAX_MESSAGE_CHARS, one_line
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.files import MAX_YAML_VALUES, parse_yaml, read_text
+from rgbd_eval.files import MAX_YAML_VALUES, check_folder, parse_yaml, read_text, too_deep
 
 
 def _error(message: str) -> ConfigError:
@@ -64,3 +64,34 @@ def test_error_lines_are_bounded() -> None:
     line = one_line(text)
     assert len(line) < MAX_MESSAGE_CHARS + 40 and line.endswith("(19399 more characters)")
     assert one_line("a\n  b") == "a b"
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "[" * 5000 + "]" * 5000,  # flow sequences
+        "a: " + "{a: " * 2000 + "1" + "}" * 2000,  # flow mappings
+        "".join("  " * i + "a:\n" for i in range(500)) + "  " * 500 + "b: 1\n",  # block
+    ],
+)
+def test_deep_yaml_is_refused_before_the_recursive_composer(text: str) -> None:
+    with pytest.raises(ConfigError, match="YAML nests deeper than 100 levels"):
+        parse_yaml(text, _error)
+    shallow = "a: " + "{a: " * 99 + "1" + "}" * 99
+    assert too_deep(parse_yaml(shallow, _error)) is False
+
+
+def test_too_deep_walks_without_recursion() -> None:
+    deep: list[object] = []
+    for _ in range(5000):
+        deep = [deep]
+    assert too_deep(deep) and not too_deep([[1], {"a": [2]}])
+
+
+def test_folder_entries_must_be_regular(tmp_path: Path) -> None:
+    (tmp_path / "metadata.yaml").write_text("a: 1\n")
+    (tmp_path / "sub").mkdir()
+    check_folder(tmp_path, _error)
+    os.mkfifo(tmp_path / "bag.db3")
+    with pytest.raises(ConfigError, match=r"entry bag\.db3 is a named pipe"):
+        check_folder(tmp_path, _error)

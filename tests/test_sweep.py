@@ -145,3 +145,10 @@ def test_cli_refuses_a_cache_folder_that_is_a_file_and_a_bad_cluster(tmp_path: P
     result = CliRunner().invoke(app, [*args, "--cache-mode", "nfs"])
     assert result.exit_code == 4 and "expected shared or client" in result.output
     assert not (tmp_path / "o").exists()
+
+
+def test_a_grid_is_bounded_before_it_is_built() -> None:
+    params = [SweepParam("tracker.min_confidence", tuple(range(1000))) for _ in range(2)]
+    params[1] = SweepParam("tracker.acceleration_variance", tuple(range(1, 1001)))
+    with pytest.raises(ConfigError, match=r"the grid has 1000000 points \(1000 tracker"):
+        expand_grid(params)

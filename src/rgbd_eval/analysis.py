@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -73,25 +73,37 @@ class SequenceInput:
     camera: bd.CameraPath | None
     #: Why there is no camera path (when ``camera`` is None).
     camera_note: str = ""
+    #: The recording frame of the first scored frame (frame ``k`` of the table is
+    #: ``first_frame + k``; ``run`` scores only the annotated span).
+    first_frame: int = 0
 
 
 def inputs_of_run(results: Sequence[SequenceResult]) -> list[SequenceInput]:
-    """The scored sequences of a run (camera from the recording's odometry and tf)."""
+    """The scored sequences of a run (camera from the recording's odometry and tf), each cut
+    to the frames it was scored on: the ground truth's annotated span
+    (:class:`~rgbd_eval.pipeline.GroundTruthMatch`), as its per-frame table is."""
     out = []
     for r in results:
         if r.scores is None or r.ground_truth is None:
             continue
+        gt = r.ground_truth
+        first, last = gt.span if gt.span is not None else (0, len(gt.frames) - 1)
+        scored = slice(first, last + 1)
         poses = r.detections.camera_poses
         camera = None
         if poses:
             camera = bd.CameraPath.from_poses(
-                r.detections.stamps_ns,
-                list(poses),
+                r.detections.stamps_ns[scored],
+                list(poses[scored]),
                 f"the recording's odometry and tf ({r.info.world_frame})",
                 odometry=r.info.has_odometry,
             )
         note = "" if camera is not None else "no camera poses were kept"
-        out.append(SequenceInput(r.name, r.scores, r.ground_truth.frames, r.tracks, camera, note))
+        out.append(
+            SequenceInput(
+                r.name, r.scores, gt.frames[scored], r.tracks[scored], camera, note, first
+            )
+        )
     return out
 
 
@@ -228,7 +240,7 @@ def analyse(
                 b.all(),
                 _band_intervals(reps, b.all()),
                 b.gaps,
-                b.persons,
+                _shifted(b.persons, item.first_frame),
                 block,
                 table.num_frames,
             )
@@ -265,6 +277,16 @@ def analyse(
         tuple(tables),
         evaluation.gating,
         curve_points,
+    )
+
+
+def _shifted(persons: Sequence[bd.Person], first: int) -> tuple[bd.Person, ...]:
+    """``persons`` with their switches' frames counted from the recording's first frame."""
+    if not first:
+        return tuple(persons)
+    return tuple(
+        replace(p, switches=tuple(replace(s, frame=s.frame + first) for s in p.switches))
+        for p in persons
     )
 
 

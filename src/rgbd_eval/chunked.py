@@ -111,10 +111,12 @@ def advance(
 
 @dataclass(frozen=True)
 class Chunk:
-    """The detections of one chunk, and how many of its depth frames held no valid pixel."""
+    """The detections of one chunk, how many of its depth frames held no valid (or no
+    plausible) pixel, and why the first implausible one was dropped."""
 
     detections: SequenceDetections
     empty_depth_frames: int
+    implausible_depth: str | None = None
 
 
 def detect_chunk(
@@ -122,7 +124,9 @@ def detect_chunk(
 ) -> Chunk:
     """Detections of frames ``span`` from a detector resumed at ``state`` (None: fresh)."""
     detections = detect_sequence(recording, config, span=span, state=state)
-    return Chunk(detections, len(recording.empty_depth_frames))
+    unusable = len(recording.empty_depth_frames) + len(recording.implausible_depth_frames)
+    problem = recording.implausible_depth_problem if recording.implausible_depth_frames else None
+    return Chunk(detections, unusable, problem)
 
 
 def join(recording: Recording, chunks: Sequence[Chunk]) -> SequenceDetections:
@@ -135,7 +139,8 @@ def join(recording: Recording, chunks: Sequence[Chunk]) -> SequenceDetections:
     if frames != len(recording):
         raise ValueError(f"chunks hold {frames} of {len(recording)} frames")
     if frames and sum(c.empty_depth_frames for c in chunks) == frames:
-        raise recording.no_depth_error()
+        problem = next((c.implausible_depth for c in chunks if c.implausible_depth), None)
+        raise recording.no_depth_error(problem)
     seconds: dict[str, float] = {}
     for c in chunks:
         for name, value in c.detections.seconds.items():

@@ -109,9 +109,17 @@ def _refuse_constant(name: str) -> float:
     raise ValueError(f"{name} is not a JSON number")
 
 
+def _finite_float(text: str) -> float:
+    """A JSON number as a float; ValueError when it overflows (``1e400`` reads as inf)."""
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"number {text[:40]} is too large for a float")
+    return value
+
+
 def load_report(path: Path) -> dict[str, Any]:
     """A ``report.json`` (or a run folder holding one); CompareInputError when unusable."""
-    from rgbd_eval.files import read_text
+    from rgbd_eval.files import MAX_NESTING, read_text, too_deep
 
     path = Path(path)
     if path.is_dir():
@@ -122,11 +130,17 @@ def load_report(path: Path) -> dict[str, Any]:
 
     text = read_text(path, error, "report")
     try:
-        data = json.loads(text, parse_constant=_refuse_constant)
+        data = json.loads(text, parse_constant=_refuse_constant, parse_float=_finite_float)
     except json.JSONDecodeError as err:
         raise CompareInputError(f"{path}: not valid JSON ({err.msg} at line {err.lineno})") from err
-    except ValueError as err:  # NaN / Infinity
+    except ValueError as err:  # NaN / Infinity, 1e400, an integer of thousands of digits
         raise CompareInputError(f"{path}: not valid JSON ({err})") from err
+    except RecursionError as err:  # json recurses once per level of nesting
+        raise CompareInputError(f"{path}: not a report (JSON nested too deeply)") from err
+    if too_deep(data):  # comparing configs recurses too
+        raise CompareInputError(
+            f"{path}: not a report (JSON nests deeper than {MAX_NESTING} levels)"
+        )
     if not isinstance(data, dict) or data.get("schema_version") != REPORT_SCHEMA_VERSION:
         version = data.get("schema_version") if isinstance(data, dict) else None
         raise CompareInputError(

@@ -15,10 +15,11 @@ import enum
 import itertools
 import math
 import os
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Any, get_origin
+from typing import Any, get_args, get_origin
 
+import annotated_types
 import yaml
 from pydantic import (
     BaseModel,
@@ -28,6 +29,7 @@ from pydantic import (
     ValidationError,
     model_validator,
 )
+from pydantic.fields import FieldInfo
 from pydantic_core import PydanticCustomError
 
 from rgbd_eval.errors import ConfigError
@@ -90,7 +92,10 @@ class IoConfig(_Model):
         20.0, gt=0, le=1000, description="largest header-stamp gap between streams that still pairs"
     )
     max_pose_extrapolation_ms: float = Field(
-        200.0, ge=0, description="how far a pose may be held beyond the first/last odometry stamp"
+        200.0,
+        ge=0,
+        le=60_000,
+        description="how far a pose may be held beyond the first/last odometry stamp",
     )
     wheels: WheelsConfig | None = Field(
         None, description="odometry from wheel speeds (JointState) instead of nav_msgs/Odometry"
@@ -135,7 +140,8 @@ class EvaluationConfig(_Model):
     gating: Gating = Field(Gating.IOU, description="'iou' on RGB boxes or 'metric' on the ground")
     threshold: float | None = Field(
         None,
-        gt=0.0,
+        ge=0.001,
+        le=1000.0,
         description="IoU >= threshold (default 0.5, seed 000 7.3) or distance <= threshold "
         "in metres (default 1.0, seed 001 V-B)",
     )
@@ -243,8 +249,9 @@ class RunConfig(_Model):
             try:
                 out[section] = _section(section, value, method)
             except ValidationError as err:
+                model = section_model(section, out)
                 raise PydanticCustomError(
-                    "section", format_validation_error(err, section, prefix=section)
+                    "section", format_validation_error(err, section, section, model)
                 ) from err
             except ConfigError as err:
                 raise PydanticCustomError("section", str(err)) from err
@@ -304,8 +311,49 @@ def section_model(section: str, data: Mapping[str, Any]) -> type[BaseModel]:
 # ----------------------------------------------------------------------------- loading
 
 
-def validation_parts(err: ValidationError, prefix: str = "") -> list[tuple[str, str]]:
-    """``(dotted location, message)`` of each error, the location under ``prefix``."""
+#: Pydantic error types of a numeric bound: the message names one side, we add the range.
+_BOUND_ERRORS = frozenset({"greater_than", "greater_than_equal", "less_than", "less_than_equal"})
+
+
+def _field_at(model: type[BaseModel], loc: Sequence[Any]) -> FieldInfo | None:
+    """The field of ``model`` at an error location (through nested models), if any."""
+    field: FieldInfo | None = None
+    current: Any = model
+    for part in loc:
+        if not (isinstance(current, type) and issubclass(current, BaseModel)):
+            return None
+        field = current.model_fields.get(str(part))
+        if field is None:
+            return None
+        options = (field.annotation, *get_args(field.annotation))
+        current = next(
+            (a for a in options if isinstance(a, type) and issubclass(a, BaseModel)), None
+        )
+    return field
+
+
+def _allowed_range(field: FieldInfo, name: str) -> str | None:
+    """``lo <= name <= hi`` from a field's bounds (None when it has none)."""
+    left = right = ""
+    for m in field.metadata:
+        if isinstance(m, annotated_types.Ge):
+            left = f"{m.ge} <= "
+        elif isinstance(m, annotated_types.Gt):
+            left = f"{m.gt} < "
+        elif isinstance(m, annotated_types.Le):
+            right = f" <= {m.le}"
+        elif isinstance(m, annotated_types.Lt):
+            right = f" < {m.lt}"
+    return f"{left}{name}{right}" if left or right else None
+
+
+def validation_parts(
+    err: ValidationError, prefix: str = "", model: type[BaseModel] | None = None
+) -> list[tuple[str, str]]:
+    """``(dotted location, message)`` of each error, the location under ``prefix``.
+
+    With the validated ``model``, a value out of bounds names the field's whole range.
+    """
     parts = []
     for e in err.errors():
         loc = ".".join(str(p) for p in (prefix, *e["loc"]) if p != "")
@@ -313,21 +361,36 @@ def validation_parts(err: ValidationError, prefix: str = "") -> list[tuple[str, 
         if e["type"] == "extra_forbidden":
             msg = "unknown key"
         value = e.get("input")
-        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f" (got {value!r:.80})"
-        parts.append((loc, f"{msg}{shown}"))
+        shown = "" if isinstance(value, dict) or e["type"] == "missing" else f"got {value!r:.80}"
+        field = _field_at(model, e["loc"]) if model is not None else None
+        if e["type"] in _BOUND_ERRORS and field is not None and e["loc"]:
+            allowed = _allowed_range(field, str(e["loc"][-1]))
+            if allowed is not None:
+                shown += f"; allowed: {allowed}"
+        parts.append((loc, f"{msg} ({shown})" if shown else msg))
     return parts
 
 
-def format_validation_error(err: ValidationError, source: str, prefix: str = "") -> str:
+def format_validation_error(
+    err: ValidationError, source: str, prefix: str = "", model: type[BaseModel] | None = None
+) -> str:
     """One line: ``source: loc: message; loc: message``."""
-    parts = validation_parts(err, prefix)
+    parts = validation_parts(err, prefix, model)
     return f"{source}: " + "; ".join(f"{loc or '<root>'}: {msg}" for loc, msg in parts)
 
 
-def _parse_value(text: str) -> Any:
-    """Parse an override value as a YAML scalar/flow value (so -1.5, true, [1,2] work)."""
+def _parse_value(text: str, item: str) -> Any:
+    """Parse an override value as a YAML scalar/flow value (so -1.5, true, [1,2] work).
+
+    Text that is not YAML stays text; an alias bomb or deep nesting is a ConfigError
+    naming the override ``item``, as in a config file.
+    """
+    from rgbd_eval.files import YamlLimitError, load_yaml_bounded
+
     try:
-        return yaml.safe_load(text)
+        return load_yaml_bounded(text)
+    except YamlLimitError as err:
+        raise ConfigError(f"override {item[:80]!r}: {err}") from err
     except yaml.YAMLError:
         return text
 
@@ -400,7 +463,7 @@ def parse_overrides(items: Iterable[str]) -> list[tuple[str, Any]]:
             raise ConfigError(
                 f"override {item!r}: expected KEY=VALUE, e.g. tracker.min_confidence=-1"
             )
-        out.append((key.strip(), _parse_value(raw.strip())))
+        out.append((key.strip(), _parse_value(raw.strip(), item)))
     return out
 
 
@@ -434,12 +497,12 @@ def build_config(
         try:
             merged[section] = _section(section, merged.get(section), method)
         except ValidationError as err:
-            parts += validation_parts(err, section)
+            parts += validation_parts(err, section, section_model(section, merged))
     if not parts:
         try:
             return RunConfig.model_validate(merged)
         except ValidationError as err:
-            parts = validation_parts(err)
+            parts = validation_parts(err, model=RunConfig)
     blamed = []
     for loc, msg in parts:
         by = next(

@@ -9,7 +9,8 @@ Exit codes (also in README.md):
 ====  =====================================================================
 0     success (scored, or nothing to score and the report says so)
 1     ``compare``: a metric regressed beyond its tolerance
-2     command-line usage error; ``compare``: unusable reports
+2     command-line usage error; ``compare``: unusable reports; an optional dependency
+      missing (``run --rerun``, ``view``: the Rerun SDK)
 3     bad input recording (missing, truncated, wrong content)
 4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
@@ -72,6 +73,12 @@ class TransformError(InputError):
     """The tf chain from the world frame to the camera is broken."""
 
 
+class ExtraError(RgbdEvalError):
+    """A feature needs an optional dependency (a pip extra) that is not installed."""
+
+    exit_code = 2
+
+
 class ConfigError(RgbdEvalError):
     """A configuration file or override is invalid."""
 
@@ -79,13 +86,16 @@ class ConfigError(RgbdEvalError):
 
 
 class GroundTruthError(RgbdEvalError):
-    """Ground truth is missing, unreadable or contradictory."""
+    """Ground truth is missing, unreadable or contradictory (``topic``: inside a recording)."""
 
     exit_code = 5
 
-    def __init__(self, path: Path | str, message: str) -> None:
+    def __init__(self, path: Path | str, message: str, topic: str | None = None) -> None:
         self.path = Path(path)
-        super().__init__(f"{self.path}: {message}")
+        self.topic = topic
+        self.message = message
+        where = f"{self.path}" + (f" [{topic}]" if topic else "")
+        super().__init__(f"{where}: {message}")
 
 
 class ScoringError(RgbdEvalError):

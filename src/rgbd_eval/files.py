@@ -3,8 +3,11 @@
 A named pipe blocks ``open`` forever and a link to ``/dev/zero`` never ends, so
 every input path is checked with ``stat`` before it is opened. Text is decoded as
 UTF-8, with the byte-order mark that spreadsheet programs write skipped. YAML is
-parsed with duplicate keys refused and aliases bounded (an alias "bomb" expands
-exponentially). Every failure is the caller's own error class, one line.
+parsed with duplicate keys refused, aliases bounded (an alias "bomb" expands
+exponentially) and nesting bounded (PyYAML and ``json`` recurse once per level: a
+document 2,000 levels deep was a RecursionError). A folder input (a ROS2 bag) may
+hold only regular files and folders. Every failure is the caller's own error class,
+one line.
 """
 
 from __future__ import annotations
@@ -26,6 +29,9 @@ ErrorFactory = Callable[[str], RgbdEvalError]
 MAX_TEXT_BYTES = 256 << 20
 #: Most values a YAML document may expand to through aliases (configs hold a few hundred).
 MAX_YAML_VALUES = 100_000
+#: Deepest nesting of mappings and lists in a YAML or JSON input (configs and reports
+#: nest fewer than 10 levels; Python's recursion limit is 1000).
+MAX_NESTING = 100
 
 
 def file_kind(mode: int) -> str:
@@ -117,6 +123,74 @@ class _StrictLoader(yaml.SafeLoader):
         return super().construct_mapping(node, deep)
 
 
+def check_folder(path: Path, error: ErrorFactory, what: str = "folder") -> None:
+    """The caller's error unless every entry of folder ``path`` is a regular file or folder.
+
+    A reader that opens a folder's files by name (a ROS2 bag's ``metadata.yaml`` and
+    storage files) would block on a named pipe there; nothing is opened here.
+    """
+    try:
+        entries = sorted(os.scandir(path), key=lambda e: e.name)
+    except OSError as err:
+        raise error(f"cannot read {what} ({err.strerror})") from err
+    for entry in entries:
+        try:
+            mode = os.stat(entry.path).st_mode  # links followed, as the reader's open would
+        except OSError as err:
+            raise error(f"cannot read {what} entry {entry.name} ({err.strerror})") from err
+        if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):
+            raise error(
+                f"{what} entry {entry.name} is {file_kind(mode)}, not a regular file (not opened)"
+            )
+
+
+def too_deep(value: Any, limit: int = MAX_NESTING) -> bool:
+    """Whether parsed data (dicts and lists) nests deeper than ``limit`` levels (no recursion)."""
+    stack: list[tuple[Any, int]] = [(value, 0)]
+    while stack:
+        item, depth = stack.pop()
+        if isinstance(item, dict | list):
+            if depth >= limit:
+                return True
+            children = item.values() if isinstance(item, dict) else item
+            stack.extend((child, depth + 1) for child in children)
+    return False
+
+
+class YamlLimitError(ValueError):
+    """A YAML text is valid but too big once expanded, or nested too deeply."""
+
+
+def _yaml_depth_problem(text: str, limit: int) -> str | None:
+    """Why ``text`` nests too deeply (None when it does not); yaml.YAMLError on bad syntax.
+
+    Walks the parser's events, which PyYAML produces without recursion (the composer
+    and constructor recurse once per level).
+    """
+    depth = 0
+    for event in yaml.parse(text, Loader=yaml.SafeLoader):
+        if isinstance(event, yaml.events.CollectionStartEvent):
+            depth += 1
+            if depth > limit:
+                return f"YAML nests deeper than {limit} levels"
+        elif isinstance(event, yaml.events.CollectionEndEvent):
+            depth -= 1
+    return None
+
+
+def load_yaml_bounded(text: str, limit: int = MAX_YAML_VALUES, max_depth: int = MAX_NESTING) -> Any:
+    """YAML text parsed with duplicate keys refused; yaml.YAMLError on bad syntax,
+    :class:`YamlLimitError` when it nests deeper than ``max_depth`` or expands to more
+    than ``limit`` values through aliases."""
+    problem = _yaml_depth_problem(text, max_depth)
+    if problem is not None:
+        raise YamlLimitError(problem)
+    data = yaml.load(text, Loader=_StrictLoader)  # a SafeLoader subclass
+    if _expanded_size(data, limit) > limit:
+        raise YamlLimitError(f"YAML expands to more than {limit} values through aliases")
+    return data
+
+
 def _expanded_size(value: Any, limit: int) -> int:
     """Number of values in ``value`` counting shared (aliased) parts each time; stops past limit."""
     count = 0
@@ -133,16 +207,16 @@ def _expanded_size(value: Any, limit: int) -> int:
 
 
 def parse_yaml(text: str, error: ErrorFactory, limit: int = MAX_YAML_VALUES) -> Any:
-    """Parse YAML text: duplicate keys and alias bombs are errors; messages kept short.
+    """Parse YAML text: duplicate keys, alias bombs and deep nesting are errors; messages
+    kept short.
 
     ``limit`` bounds the values after alias expansion (data files such as a dataset's
     annotations hold more than any configuration).
     """
     try:
-        data = yaml.load(text, Loader=_StrictLoader)  # a SafeLoader subclass
+        return load_yaml_bounded(text, limit)
+    except YamlLimitError as err:
+        raise error(str(err)) from err
     except yaml.YAMLError as err:
         message = " ".join(str(err).split())
         raise error(f"not valid YAML ({message[:300]})") from err
-    if _expanded_size(data, limit) > limit:
-        raise error(f"YAML expands to more than {limit} values through aliases")
-    return data

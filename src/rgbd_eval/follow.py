@@ -324,6 +324,7 @@ def follow(
     steps: list[FollowStep] = []
     all_tracks: list[tuple[TrackOutput, ...]] = []
     truth: list[tuple[GroundTruthObject, ...]] = []
+    annotated: list[tuple[int, int]] = []  # (frame, stamp) of every frame written
     locked: int | None = None
     lost = False
     cpu = {"render": 0.0, "detect": 0.0, "track": 0.0}
@@ -365,6 +366,7 @@ def follow(
             cpu["track"] += c4 - c3
             all_tracks.append(tracks)
             truth.append(tuple(f.ground_truth))
+            annotated.append((i, f.stamp_ns))
             where = next(
                 (
                     (o.world_xyz[0], o.world_xyz[1])
@@ -383,7 +385,9 @@ def follow(
             if progress is not None:
                 progress(i + 1, n)
     if out_path is not None:
-        write_csv(ground_truth_path(out_path), [o for frame in truth for o in frame], OWNER)
+        write_csv(
+            ground_truth_path(out_path), [o for frame in truth for o in frame], annotated, OWNER
+        )
     summary = _summary(scenario, sim.seed, target, steps, c)
     return FollowResult(tuple(steps), summary, tuple(all_tracks), tuple(truth), cpu)
 

@@ -45,12 +45,44 @@ class SequenceDetections:
 
 @dataclass(frozen=True)
 class GroundTruthMatch:
-    """Ground truth aligned with the recording's frames."""
+    """Ground truth aligned with the recording's frames.
+
+    Only the frames from the first recording frame an annotated frame matched to the
+    last (``span``) are scored: before and after, nothing says whether nobody was there
+    or nobody annotated (a file covering the first 10 of 40 frames is not 30 empty
+    frames). Frames inside the span without annotations are frames with nobody in them.
+    """
 
     source: str
     frames: list[list[GroundTruthObject]]
     annotated_frames: int
     unmatched_frames: int
+    span: tuple[int, int] | None = None
+    max_gap_ms: float = 0.0
+
+    @property
+    def unscored_frames(self) -> int:
+        """Recording frames outside the annotated span (not scored)."""
+        if self.span is None:
+            return 0
+        return len(self.frames) - (self.span[1] - self.span[0] + 1)
+
+    @property
+    def warnings(self) -> tuple[str, ...]:
+        """Annotated frames matching no recording frame, recording frames left unscored."""
+        out = []
+        if self.unmatched_frames:
+            out.append(
+                f"{self.unmatched_frames} of {self.annotated_frames} annotated frames of "
+                f"{self.source} match no frame of the recording (nearest stamp within "
+                f"{self.max_gap_ms:g} ms) and are not scored"
+            )
+        if self.unscored_frames and self.span is not None:
+            out.append(
+                f"{self.unscored_frames} of {len(self.frames)} frames lie outside the "
+                f"annotated span (frames {self.span[0]}..{self.span[1]}) and are not scored"
+            )
+        return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -230,8 +262,10 @@ def match_ground_truth(
     gt: GroundTruth, stamps_ns: Sequence[int], config: RunConfig
 ) -> GroundTruthMatch:
     """Align annotations with frames by nearest stamp (within the sync gap)."""
-    frames, unmatched = gt.align(stamps_ns, int(config.io.max_sync_gap_ms * 1e6))
-    return GroundTruthMatch(gt.source, frames, len(gt.frames), unmatched)
+    gap_ms = config.io.max_sync_gap_ms
+    frames, unmatched, matched = gt.match(stamps_ns, int(gap_ms * 1e6))
+    span = (matched[0], matched[-1]) if matched else None
+    return GroundTruthMatch(gt.source, frames, len(gt.frames), unmatched, span, gap_ms)
 
 
 def ground_truth_file(path: Path, gt_path: Path | None) -> GroundTruth | None:
@@ -251,14 +285,20 @@ def find_ground_truth(path: Path, recording: Recording, gt_path: Path | None) ->
 def score_sequence(
     gt: GroundTruthMatch, tracks: Sequence[Sequence[TrackOutput]], config: RunConfig
 ) -> SequenceScores:
-    """CLEAR MOT scores of one sequence; ScoringError when nothing can be compared."""
+    """CLEAR MOT scores of the annotated span of one sequence (the frames outside get empty
+    events, see :class:`GroundTruthMatch`); ScoringError when nothing can be compared."""
     if gt.annotated_frames and gt.unmatched_frames == gt.annotated_frames:
         raise ScoringError(
             f"{gt.source}: none of its {gt.annotated_frames} annotated frames matches a frame "
             f"stamp of the recording (within {config.io.max_sync_gap_ms} ms)"
         )
-    if gt.annotated_frames == 0:
-        raise GroundTruthError(gt.source, "holds no annotated object (only a header?)")
+    if not any(gt.frames):
+        raise GroundTruthError(
+            gt.source,
+            "holds no annotated object (only a header?)"
+            if gt.annotated_frames == 0
+            else "annotates nobody in the frames that match the recording",
+        )
     needs = "box2d" if config.evaluation.gating is Gating.IOU else "world_xyz"
     if not any(getattr(o, needs) is not None for frame in gt.frames for o in frame):
         other = "metric" if config.evaluation.gating is Gating.IOU else "iou"
@@ -267,7 +307,16 @@ def score_sequence(
             f"{'image boxes' if needs == 'box2d' else 'world positions'}, which this ground "
             f"truth does not have (try --gating {other})"
         )
-    return evaluate_sequence(gt.frames, tracks, config.evaluation)
+    if len(tracks) != len(gt.frames):
+        raise ScoringError(
+            f"ground truth has {len(gt.frames)} frames but the tracker output has "
+            f"{len(tracks)}; they must be index-aligned"
+        )
+    first, last = gt.span if gt.span is not None else (0, len(gt.frames) - 1)
+    scores = evaluate_sequence(
+        gt.frames[first : last + 1], tracks[first : last + 1], config.evaluation
+    )
+    return scores.placed(first, len(gt.frames))
 
 
 def warmup_warnings(config: RunConfig, frames: int) -> tuple[str, ...]:

@@ -162,8 +162,15 @@ def run_notes(results: Sequence[SequenceResult], warnings: bool = True) -> list[
 
 
 def run_warnings(results: Sequence[SequenceResult]) -> list[str]:
-    """``<name>: warning: ...`` for each warning of each sequence (reader, detector)."""
-    return [f"{r.name}: warning: {w}" for r in results for w in r.info.warnings]
+    """``<name>: warning: ...`` for each warning of each sequence (reader, detector, ground
+    truth)."""
+    return [f"{r.name}: warning: {w}" for r in results for w in sequence_warnings(r)]
+
+
+def sequence_warnings(r: SequenceResult) -> list[str]:
+    """The reader's warnings, then the ground truth's (frames matched or left unscored)."""
+    gt = r.ground_truth.warnings if r.ground_truth is not None else ()
+    return [*r.info.warnings, *gt]
 
 
 def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
@@ -177,7 +184,7 @@ def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
         "has_odometry": info.has_odometry,
         "world_frame": info.world_frame,
         "sync": asdict(info.sync),
-        "warnings": list(info.warnings),
+        "warnings": sequence_warnings(r),
         "provenance": None if info.provenance is None else dict(info.provenance),
         "skipped_messages": [asdict(s) for s in info.skipped],  # damaged, per topic
         "ground_truth": None
@@ -186,6 +193,9 @@ def sequence_record(r: SequenceResult, digest: str) -> dict[str, Any]:
             "source": gt.source,
             "annotated_frames": gt.annotated_frames,
             "unmatched_frames": gt.unmatched_frames,
+            # recording frames outside the annotated span (first..last matched frame)
+            "unscored_frames": gt.unscored_frames,
+            "scored_span": list(gt.span) if gt.span is not None else None,
         },
         "scored": r.scores is not None,
         "counts": None if r.scores is None else r.scores.counts.to_dict(),

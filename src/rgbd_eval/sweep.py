@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import enum
 import itertools
+import math
 import threading
 import time
 import uuid
@@ -108,13 +109,28 @@ def parse_param(spec: str) -> SweepParam:
     return SweepParam(key.strip(), values)
 
 
+#: Most grid points a sweep may have: each is validated, then run on every recording, and
+#: the product of a few long value lists grows fast (1000 x 1000 exhausted memory).
+MAX_GRID_POINTS = 10_000
+
+
 def expand_grid(params: Sequence[SweepParam]) -> list[Point]:
-    """The Cartesian product of the parameters' values, first parameter slowest."""
+    """The Cartesian product of the parameters' values, first parameter slowest.
+
+    ConfigError beyond :data:`MAX_GRID_POINTS` points (counted before any is built).
+    """
     keys = [p.key for p in params]
     if len(set(keys)) != len(keys):
         raise ConfigError(f"a parameter is swept twice: {', '.join(keys)}")
     if any(not p.values for p in params):
         raise ConfigError("every swept parameter needs at least one value")
+    size = math.prod(len(p.values) for p in params)
+    if size > MAX_GRID_POINTS:
+        counts = " x ".join(f"{len(p.values)} {p.key}" for p in params)
+        raise ConfigError(
+            f"the grid has {size} points ({counts}), more than the {MAX_GRID_POINTS} a sweep "
+            "may have; sweep fewer values"
+        )
     return [
         dict(zip(keys, combo, strict=True))
         for combo in itertools.product(*(p.values for p in params))

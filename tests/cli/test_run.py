@@ -174,7 +174,7 @@ def test_dmtbs_on_a_recording_shorter_than_its_background_initialisation_says_so
     assert outcome.code == 0, outcome
     expected = "spends all 5 frames of the recording on its background initialisation"
     assert any(
-        line.startswith("short: warning: ") and expected in line for line in outcome.error_lines
+        line.startswith("warning: short: ") and expected in line for line in outcome.error_lines
     ), outcome.stderr
     (seq,) = json.loads((out / "report.json").read_text())["sequences"]
     assert any(expected in w for w in seq["warnings"]), seq["warnings"]

@@ -3,15 +3,19 @@
 Each :class:`Case` names a failure class of issue 21 (TRACEBACK, SILENT, WRONG-CODE,
 HANG, MULTILINE, LEFTOVER), builds its inputs with the project's own writers (or by
 corrupting what they wrote), and states the documented exit code the CLI must give.
+The cases of issue 28 (sizes taken from inputs before allocating, values taken on
+trust) follow the others.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import json
+import math
 import os
 import stat
 import struct
+import zlib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -72,6 +76,16 @@ def good_recording(root: Path, name: str = "rec.mcap", container: Container = "m
     return path
 
 
+def write_rig(w: RecordingWriter, odom: Callable[[int], Pose] = odom_pose) -> None:
+    """The test rig's static tf and 50 Hz odometry ``odom(stamp)`` over FRAMES frames."""
+    w.write_static_transform(T0, "base_link", "camera_link", BASE_TO_CAMERA)
+    w.write_static_transform(T0, "camera_link", "camera_rgb_optical_frame", OPTICAL_TO_BODY)
+    w.write_static_transform(T0, "camera_link", "camera_depth_optical_frame", DEPTH_OFFSET)
+    for k in range(FRAMES * 2 + 4):
+        s = T0 - 20_000_000 + k * 20_000_000
+        w.write_odometry(s, "odom", "base_link", odom(s))
+
+
 def odd_recording(
     path: Path,
     container: Container = "ros1",
@@ -82,12 +96,7 @@ def odd_recording(
 ) -> Path:
     """A 4-frame recording whose odometry, depth or image size is replaced."""
     with RecordingWriter(path, container) as w:
-        w.write_static_transform(T0, "base_link", "camera_link", BASE_TO_CAMERA)
-        w.write_static_transform(T0, "camera_link", "camera_rgb_optical_frame", OPTICAL_TO_BODY)
-        w.write_static_transform(T0, "camera_link", "camera_depth_optical_frame", DEPTH_OFFSET)
-        for k in range(FRAMES * 2 + 4):
-            s = T0 - 20_000_000 + k * 20_000_000
-            w.write_odometry(s, "odom", "base_link", odom(s))
+        write_rig(w, odom)
         for i in range(FRAMES):
             stamp = T0 + i * PERIOD
             rgb = rgb_image(i)[: rgb_cam.height, : rgb_cam.width]
@@ -113,12 +122,7 @@ def damaged_ros1(
     ``damaged(i)`` are altered: ``image`` rewrites the Image fields, ``info`` the
     CameraInfo message, ``cut`` drops that many bytes from the serialised Image."""
     with RecordingWriter(path, "ros1") as w:
-        w.write_static_transform(T0, "base_link", "camera_link", BASE_TO_CAMERA)
-        w.write_static_transform(T0, "camera_link", "camera_rgb_optical_frame", OPTICAL_TO_BODY)
-        w.write_static_transform(T0, "camera_link", "camera_depth_optical_frame", DEPTH_OFFSET)
-        for k in range(FRAMES * 2 + 4):
-            s = T0 - 20_000_000 + k * 20_000_000
-            w.write_odometry(s, "odom", "base_link", odom_pose(s))
+        write_rig(w)
         for i, obj in enumerate(ground_truth_objects()):
             stamp = T0 + i * PERIOD
             w.write_rgb(stamp, rgb_image(i), RGB_CAM)
@@ -716,6 +720,15 @@ def _score_cases() -> list[Case]:
             3,
             "line 2",
         ),
+        Case(
+            "score_tracks_csv_conf_nan",  # a NaN confidence would be dropped at every threshold
+            "SILENT",
+            tracks_file(
+                "t.csv", header.replace(b",x,", b",conf,x,") + b"1,7,0,0,10,10,nan,1,1,1,0\n"
+            ),
+            3,
+            "confidence nan is not finite",
+        ),
         Case("score_tracks_fifo", "HANG", tracks_fifo, 3, "named pipe"),
         Case("score_out_is_file", "TRACEBACK", score_into(a_file), 7, "not a folder"),
         Case("score_out_foreign_folder", "DATA-LOSS", score_into(foreign), 7, "--force"),
@@ -879,6 +892,16 @@ def _ownership_cases() -> list[Case]:
 
         return build
 
+    def score_into_users(*names: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            mine(root, *(f"out/{n}" for n in names))
+            (root / "t.txt").write_text(MOT_TRACKS)
+            (root / "g.txt").write_text(MOT_GT)
+            args = ["score", str(root / "t.txt"), "--gt", str(root / "g.txt")]
+            return [*args, "--out", str(root / "out"), "--force"]
+
+        return build
+
     def run_into_sweep_folder(root: Path) -> list[str]:
         rec = good_recording(root)
         first = run_isolated(two_point_sweep(rec, root / "res"), root)
@@ -974,6 +997,22 @@ def _ownership_cases() -> list[Case]:
             7,
             "rec.tracks.csv",
             kept("out/rec.tracks.csv"),
+        ),
+        Case(
+            "out_force_user_frames_npz",
+            "DATALOSS",
+            run_into_users("rec.frames.npz", force=True),
+            7,
+            "rec.frames.npz",
+            kept("out/rec.frames.npz"),
+        ),
+        Case(
+            "out_force_score_user_frames_npz",
+            "DATALOSS",
+            score_into_users("t.frames.npz"),
+            7,
+            "t.frames.npz",
+            kept("out/t.frames.npz"),
         ),
         Case(
             "out_run_into_sweep_folder",
@@ -1077,6 +1116,241 @@ def _path_and_disk_cases() -> list[Case]:
     ]
 
 
+# Sizes taken from an input are bounded before anything is allocated; values a reader
+# used to take on trust are checked (ground truth: exit 5, wherever it comes from).
+
+GT_HEADER_IGNORE = GT_HEADER.rstrip("\n") + ",ignore\n"
+#: Ten years past T0: a stamp no recording frame is near.
+FAR_FUTURE_NS = 10 * 365 * 86_400 * 10**9
+
+
+def gt_topic_recording(
+    path: Path,
+    people: Callable[[int], list[GroundTruthObject]] | None = None,
+    stamp: Callable[[int], int] | None = None,
+) -> Path:
+    """A 4-frame MCAP recording whose ground-truth topic holds ``people(i)`` in frame ``i``
+    (default: one person), stamped ``stamp(i)`` (default: the frame's stamp)."""
+    objects = ground_truth_objects()
+    with RecordingWriter(path, "mcap") as w:
+        write_rig(w)
+        for i in range(FRAMES):
+            frame_stamp = T0 + i * PERIOD
+            w.write_rgb(frame_stamp, rgb_image(i), RGB_CAM)
+            w.write_depth(frame_stamp + 2_000_000, depth_image(i), DEPTH_CAM)
+            gt_stamp = stamp(i) if stamp is not None else frame_stamp
+            w.write_ground_truth(gt_stamp, "odom", people(i) if people else [objects[i]])
+    return path
+
+
+def _first_frame(*objects: GroundTruthObject) -> Callable[[int], list[GroundTruthObject]]:
+    """Frame 0 holds ``objects``, the others one person each."""
+    rest = ground_truth_objects()
+    return lambda i: list(objects) if i == 0 else [rest[i]]
+
+
+def _gt_value_cases() -> list[Case]:
+    row = "0,0,1,10,5,8,30,2.0,0.1,0.9,1"
+
+    def gt_rows(rows: list[str], header: str = GT_HEADER) -> bytes:
+        return (header + "".join(f"{r}\n" for r in rows)).encode()
+
+    def by_index(i: int) -> str:  # person 7 in frame i, no stamps: matched by frame index
+        return f"{i},0,7,{10 + i},5,8,30,2.0,{0.1 * i},0.9,1"
+
+    def by_stamp(i: int, offset: int = 0) -> str:
+        return f"{i},{T0 + i * PERIOD + offset},7,{10 + i},5,8,30,2.0,{0.1 * i},0.9,1"
+
+    hour = 3600 * 10**9
+
+    def topic(
+        people: Callable[[int], list[GroundTruthObject]], *extra: str
+    ) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            rec = gt_topic_recording(root / "gt.mcap", people)
+            return ["run", str(rec), *extra, "--out", str(root / "out")]
+
+        return build
+
+    def folder_of_recordings(root: Path) -> list[str]:
+        (root / "f").mkdir()
+        good_recording(root / "f", "a.mcap")
+        good_recording(root / "f", "b.mcap")
+        (root / "base.gt.csv").write_bytes(gt_rows([row]))
+        return [
+            "run",
+            str(root / "f"),
+            "--gt",
+            str(root / "base.gt.csv"),
+            "--out",
+            str(root / "out"),
+        ]
+
+    def far_future(root: Path) -> list[str]:
+        stamps = lambda i: T0 + i * PERIOD + (FAR_FUTURE_NS if i == 1 else 0)  # noqa: E731
+        rec = gt_topic_recording(root / "fut1.mcap", stamp=stamps)
+        return ["run", str(rec), "--out", str(root / "out")]
+
+    inf_box = GroundTruthObject(0, T0, 1, Box2D(0.0, 133.8, math.inf, 284.4), None)
+    nan_left = GroundTruthObject(0, T0, 1, Box2D(math.nan, 133.8, 0.617, 284.4), None)
+    nan_y = GroundTruthObject(0, T0, 1, None, (4.0, math.nan, 0.9))
+    person = GroundTruthObject(0, T0, 1, Box2D(10.0, 5.0, 8.0, 30.0), (2.0, 0.0, 0.9))
+    ignore = GT_HEADER_IGNORE
+    return [
+        _gt_case("ignore_2", gt_rows([f"{row},2"], ignore), 5, "ignore '2' is not 0, 1"),
+        _gt_case("ignore_no", gt_rows([f"{row},no"], ignore), 5, "ignore 'no' is not"),
+        _gt_case("ignore_FALSE_upper", gt_rows([f"{row},FALSE"], ignore), 0, ""),
+        _gt_case("box_negative_zero", gt_rows(["0,0,1,10,5,-0,30,2.0,0.1,0.9,1"]), 5, "negative"),
+        _gt_case("box_zero_height", gt_rows(["0,0,1,10,5,8,0,,,,1"]), 5, "empty"),
+        _gt_case("box_1e300", gt_rows(["0,0,1,1e300,5,8,30,2.0,0.1,0.9,1"]), 5, "beyond"),
+        _gt_case("xyz_1e30", gt_rows(["0,0,1,10,5,8,30,1e30,0.1,0.9,1"]), 5, "beyond"),
+        _gt_case("frame_negative", gt_rows(["-1,0,1,10,5,8,30,,,,1"]), 5, "frame number -1"),
+        _gt_case("stamp_2e19", gt_rows(["0,20000000000000000000,1,10,5,8,30,,,,1"]), 5, "stamp"),
+        _gt_case("only_empty_frames", gt_rows(["0,0,,,,,,,,,", "1,0,,,,,,,,,"]), 5, "no annotated"),
+        # Frames outside the annotated span are not scored (a warning says how many).
+        _gt_case("only_first_2_frames", gt_rows([by_index(0), by_index(1)]), 0, ""),
+        _gt_case(
+            "stamps_one_hour_gap",
+            gt_rows([by_stamp(0), by_stamp(1), by_stamp(2, hour), by_stamp(3, hour)]),
+            0,
+            "",
+        ),
+        Case("gt_for_folder_of_recordings", "WRONG-CODE", folder_of_recordings, 5, "single"),
+        Case("gttopic_inf_box", "WRONG-CODE", topic(_first_frame(inf_box)), 5, "finite"),
+        Case(
+            "gttopic_nan_box_left",
+            "WRONG-CODE",
+            topic(_first_frame(nan_left)),
+            5,
+            "finite",
+        ),
+        Case(
+            "gttopic_nan_y_only_metric",
+            "WRONG-CODE",
+            topic(_first_frame(nan_y), "--gating", "metric"),
+            5,
+            "[/ground_truth]: frame 0, id 1: position",
+        ),
+        Case(
+            "gttopic_duplicate_ids",
+            "WRONG-CODE",
+            topic(_first_frame(person, person)),
+            5,
+            "id 1 appears twice in frame 0",
+        ),
+        Case("rec_stamps_one_far_future", "SILENT", far_future, 0, ""),
+    ]
+
+
+def _score_mot(
+    gt: bytes | str,
+    tracks: bytes | str = MOT_TRACKS,
+    *extra: str,
+    seqinfo: str | None = None,
+) -> Callable[[Path], list[str]]:
+    """``score t.txt --gt gt.txt`` on MOTChallenge text (with a seqinfo.ini beside it)."""
+
+    def build(root: Path) -> list[str]:
+        for name, data in (("t.txt", tracks), ("gt.txt", gt)):
+            (root / name).write_bytes(data.encode() if isinstance(data, str) else data)
+        if seqinfo is not None:
+            (root / "seqinfo.ini").write_text(seqinfo)
+        gt_path, tracks_path = str(root / "gt.txt"), str(root / "t.txt")
+        return ["score", tracks_path, "--gt", gt_path, *extra, "--out", str(root / "o")]
+
+    return build
+
+
+def _mot_value_cases() -> list[Case]:
+    mot15 = "1,1,0,0,10,10,1,-1,-1,-1\n2,1,0,0,10,10,1,-1,-1,-1\n"
+    return [
+        Case("score_gt_binary", "WRONG-CODE", _score_mot(bytes(range(256)) * 4), 5, "not UTF-8"),
+        Case("score_gt_nan_box", "WRONG-CODE", _score_mot("1,1,nan,0,10,10,1,1,1\n"), 5, "finite"),
+        Case(
+            "score_gt_negative_box",
+            "WRONG-CODE",
+            _score_mot("1,1,103,60,-40,100,1,1,1\n"),
+            5,
+            "negative",
+        ),
+        Case("score_gt_empty_file", "SILENT", _score_mot(""), 5, "no annotated object"),
+        Case(
+            "score_gt_frame_fractional",
+            "SILENT",
+            _score_mot("1.5,1,0,0,10,10,1,1,1\n2,1,0,0,10,10,1,1,1\n"),
+            5,
+            "frame 1.5 is not a whole number",
+        ),
+        Case(
+            "score_tracks_frame_fractional",
+            "SILENT",
+            _score_mot(MOT_GT, "1.5,7,0,0,10,10,-1,-1,-1,-1\n"),
+            3,
+            "frame 1.5 is not a whole number",
+        ),
+        Case(
+            "score_gt_frame_huge_1e8",
+            "TRACEBACK",
+            _score_mot(MOT_GT + "100000000,1,0,0,10,10,1,1,1\n"),
+            5,
+            "frame 1e+08",
+        ),
+        Case(
+            "score_gt_frames_far_apart",
+            "TRACEBACK",
+            _score_mot(MOT_GT + "5000000,1,0,0,10,10,1,1,1\n"),
+            5,
+            "span more than the 100000 frames",
+        ),
+        Case(
+            "score_tracks_frame_huge_2e9",
+            "TRACEBACK",
+            _score_mot(MOT_GT, MOT_TRACKS + "2000000000,7,0,0,10,10,-1,-1,-1,-1\n"),
+            3,
+            "frame 2e+09",
+        ),
+        Case(
+            "score_tracks_box_1e300",
+            "TRACEBACK",
+            _score_mot(MOT_GT, "1,7,1e300,0,10,10,-1,-1,-1,-1\n"),
+            3,
+            "beyond",
+        ),
+        Case(
+            "score_seqinfo_length_1e9",
+            "TRACEBACK",
+            _score_mot(MOT_GT, seqinfo="[Sequence]\nname=x\nseqLength=1000000000\n"),
+            5,
+            "seqLength 1000000000 outside",
+        ),
+        Case(
+            "score_tracks_beyond_seqlength",
+            "SILENT",
+            _score_mot(
+                MOT_GT,
+                MOT_TRACKS + "9,7,0,0,10,10,-1,-1,-1,-1\n",
+                seqinfo="[Sequence]\nseqLength=2\n",
+            ),
+            3,
+            "frame 9 outside 1..2",
+        ),
+        Case(
+            "score_benchmark_mot17_on_mot15",
+            "SILENT",
+            _score_mot(mot15, MOT_TRACKS, "--benchmark", "mot17"),
+            5,
+            "not a MOTChallenge class",
+        ),
+        Case(
+            "score_gt_nothing_scored",
+            "SILENT",
+            _score_mot("1,1,0,0,10,10,1,7,1\n2,1,0,0,10,10,0,1,1\n"),
+            5,
+            "no row is scored",
+        ),
+    ]
+
+
 def _cluster_and_cache_cases() -> list[Case]:
     def reproduce(*extra: str) -> Callable[[Path], list[str]]:
         """``reproduce basso2012`` with ``extra`` options ({root} is the case's folder)."""
@@ -1170,6 +1444,304 @@ def _cluster_and_cache_cases() -> list[Case]:
     ]
 
 
+def _nesting_and_size_cases() -> list[Case]:
+    deep_block = "".join("  " * i + "a:\n" for i in range(2000)) + "  " * 2000 + "b: 1\n"
+    deep_flow = "tracker: " + "{a: " * 2000 + "1" + "}" * 2000 + "\n"
+    bomb = (
+        "tracker.min_confidence={a: &a [1,1,1,1,1,1,1,1,1], "
+        + ", ".join(
+            f"{c}: &{c} [{', '.join([f'*{p}'] * 9)}]"
+            for p, c in zip("abcdefgh", "bcdefghi", strict=True)
+        )
+        + "}"
+    )
+    deep_report = json.dumps(report(BASE_METRICS))[:-1] + ', "config": '
+    deep_report += '{"a": ' * 500 + "1" + "}" * 500 + "}"
+    deep_json = b'{"schema_version": 1, "x": ' + b"[" * 100_000 + b"]" * 100_000 + b"}"
+
+    def method_set(method: str, *sets: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            extra = [a for s in sets for a in ("--set", s)]
+            rec = str(good_recording(root))
+            return ["run", rec, "--method", method, *extra, "--out", str(root / "out")]
+
+        return build
+
+    def sweep_grid(root: Path) -> list[str]:
+        a = ",".join(str(-k / 1000) for k in range(1000))
+        b = ",".join(str(1 + k / 100) for k in range(1000))
+        rec = str(good_recording(root))
+        params = ["--param", f"tracker.min_confidence={a}"]
+        params += ["--param", f"tracker.acceleration_variance={b}"]
+        return ["sweep", *params, "--dataset", rec, "--out", str(root / "out")]
+
+    return [
+        _cfg_case("deep_nesting_2k", deep_block.encode(), 4, "nests deeper than 100"),
+        _cfg_case("deep_nesting_mapping", deep_flow.encode(), 4, "nests deeper than 100"),
+        _set_case("alias_bomb_9", [bomb], 4, "aliases"),
+        _set_case(
+            "deep_nesting", ["tracker.min_confidence=" + "[" * 5000 + "]" * 5000], 4, "deeper"
+        ),
+        _cfg_case("voxel_1e-9", b"detector:\n  voxel_size: 1.0e-9\n", 4, "0.01 <= voxel_size"),
+        _set_case("voxel_1e-12", ["detector.voxel_size=1e-12"], 4, "0.01 <= voxel_size <= 0.5"),
+        _cfg_case(
+            "weak_classifiers_1e9",
+            b"tracker:\n  weak_classifiers: 1000000000\n",
+            4,
+            "weak_classifiers <= 2500",
+        ),
+        _set_case("selectors_1e9", ["tracker.selectors=1000000000"], 4, "selectors <= 500"),
+        Case(
+            "set_reid_input_1e9",
+            "TRACEBACK",
+            method_set("pinto2022", "detector.reid.input_width=1000000000"),
+            4,
+            "input_width <= 2048",
+        ),
+        Case(
+            "set_dmtbs_closing_1e9",
+            "TRACEBACK",
+            method_set("dmtbs", "detector.closing_radius_m=1e9"),
+            4,
+            "closing_radius_m <= 1.0",
+        ),
+        Case("sweep_grid_1e6_points", "TRACEBACK", sweep_grid, 4, "1000000 points"),
+        _cmp_case(
+            "number_1e400",
+            None,
+            2,
+            "too large",
+            raw=json.dumps(report(BASE_METRICS)).replace("0.7", "1e400").encode(),
+        ),
+        _cmp_case("deep_nesting", None, 2, "nested too deeply", raw=deep_json),
+        _cmp_case("deep_config", None, 2, "deeper than 100", raw=deep_report.encode()),
+    ]
+
+
+def _teleport(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    hop = ((stamp - T0) // 20_000_000) % 2  # every other odometry message 5 m away
+    return Pose((p.translation[0] + 5.0 * hop, *p.translation[1:]), p.rotation)
+
+
+def _jump_1km(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    return Pose((p.translation[0] + 1000.0, *p.translation[1:]), p.rotation) if stamp > T0 else p
+
+
+def _position_1e30(stamp: int) -> Pose:
+    p = odom_pose(stamp)
+    return Pose((1e30, 0.0, 0.0), p.rotation) if stamp > T0 else p
+
+
+def _all_max_depth(i: int) -> np.ndarray:
+    return np.full((DEPTH_CAM.height, DEPTH_CAM.width), 65.535, dtype=np.float32)
+
+
+def _tiny_focal(msg: Any) -> Any:
+    K = np.array(msg.K, dtype=np.float64)
+    K[0] = 1e-300
+    return dataclasses.replace(msg, K=K)
+
+
+def png_claiming(width: int, height: int) -> bytes:
+    """A PNG whose header claims ``width`` x ``height`` RGB pixels, with almost no data."""
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body))
+
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    return (
+        b"\x89PNG\r\n\x1a\n"
+        + chunk(b"IHDR", header)
+        + chunk(b"IDAT", zlib.compress(b"\x00" * 64))
+        + chunk(b"IEND", b"")
+    )
+
+
+def _png_bomb_recording(path: Path) -> Path:
+    """A ROS1 bag whose colour images are PNGs claiming 30000 x 30000 pixels (2.7 GB)."""
+    from unittest import mock
+
+    from rgbd_eval.io import images
+    from rgbd_eval.io.writer import StreamOptions
+
+    def bomb(rgb: np.ndarray, quality: int = 90) -> dict[str, Any]:
+        return {"format": "png", "data": np.frombuffer(png_claiming(30000, 30000), np.uint8)}
+
+    with mock.patch.object(images, "encode_color_jpeg", bomb):
+        return write_recording(path, "ros1", Spec(n=FRAMES, options=StreamOptions("jpeg")))
+
+
+def _recording_value_cases() -> list[Case]:
+    def run(rec: Callable[[Path], Path], *extra: str) -> Callable[[Path], list[str]]:
+        return lambda root: ["run", str(rec(root)), *extra, "--out", str(root / "out")]
+
+    def odd(name: str, **kwargs: Any) -> Callable[[Path], Path]:
+        return lambda root: odd_recording(root / f"{name}.bag", **kwargs)
+
+    def damaged(name: str, **kwargs: Any) -> Callable[[Path], Path]:
+        return lambda root: damaged_ros1(root / f"{name}.bag", lambda i: True, **kwargs)
+
+    def bigendian(fields: dict[str, Any]) -> dict[str, Any]:
+        return {**fields, "is_bigendian": 1}  # the bytes stay little-endian
+
+    def ros2(damage: Callable[[Path], None]) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            bag = write_recording(root / "r2", "ros2-sqlite3", Spec(n=FRAMES))
+            damage(bag)
+            return ["run", str(bag), "--out", str(root / "out")]
+
+        return build
+
+    def fifo_for(pattern: str) -> Callable[[Path], None]:
+        def damage(bag: Path) -> None:
+            target = next(bag.glob(pattern))
+            target.unlink()
+            os.mkfifo(target)
+
+        return damage
+
+    def metadata_bomb(bag: Path) -> None:
+        (bag / "metadata.yaml").write_text(_BOMB)
+
+    return [
+        Case("img_depth_all_max", "SILENT", run(odd("dmax", depth=_all_max_depth)), 3, "plausible"),
+        Case(
+            "img_depth_bigendian_flag",
+            "SILENT",
+            run(damaged("bigend", image=bigendian)),
+            3,
+            "is_bigendian",
+        ),
+        Case(
+            "img_info_focal_1e-300",
+            "SILENT",
+            run(damaged("tinyf", info=_tiny_focal)),
+            3,
+            "field of view",
+        ),
+        Case(
+            "rec_odom_jump_1km", "SILENT", run(odd("jump", odom=_jump_1km)), 3, "faster than 20 m/s"
+        ),
+        Case(
+            "rec_odom_jump_1km_metric",
+            "SILENT",
+            run(odd("jumpm", odom=_jump_1km), "--gating", "metric"),
+            3,
+            "1e+03 m in",
+        ),
+        Case(
+            "rec_odom_teleport_every_other",
+            "SILENT",
+            run(odd("tele", odom=_teleport)),
+            3,
+            "[/odom]: odom->base_link moves",
+        ),
+        Case("rec_odom_1e30", "TRACEBACK", run(odd("huge", odom=_position_1e30)), 3, "beyond"),
+        Case(
+            "img_png_bomb",
+            "TRACEBACK",
+            run(lambda root: _png_bomb_recording(root / "bomb.bag")),
+            3,
+            "declares 30000x30000 pixels",
+        ),
+        Case("r2sql_metadata_fifo", "HANG", ros2(fifo_for("metadata.yaml")), 3, "named pipe"),
+        Case("r2sql_db3_is_fifo", "HANG", ros2(fifo_for("*.db3")), 3, "named pipe"),
+        Case("r2sql_metadata_alias_bomb", "TRACEBACK", ros2(metadata_bomb), 3, "aliases"),
+    ]
+
+
+def _import_cases() -> list[Case]:
+    from tests.io.epfl_folder import write_sequence
+
+    def import_fps(fps: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            folder = write_sequence(root, [None])
+            out = str(root / "x.mcap")
+            return ["import", "epfl-rgbd", str(folder), "-o", out, "--fps", fps]
+
+        return build
+
+    return [
+        Case("import_fps_1e-300", "TRACEBACK", import_fps("1e-300"), 4, "--fps 1e-300"),
+        Case("import_fps_1e300", "TRACEBACK", import_fps("1e300"), 4, "0.1..1000"),
+    ]
+
+
+def _annotate_and_view_cases() -> list[Case]:
+    """CVAT exports that are not, or not of this recording; runs `view` cannot show (issue 34)."""
+
+    def cvat(box: str = 'xtl="2.00" ytl="3.00" xbr="12.00" ybr="40.00"', size: int = FRAMES) -> str:
+        return (
+            '<?xml version="1.0" encoding="utf-8"?>\n<annotations><version>1.1</version>'
+            f"<meta><task><size>{size}</size><original_size><width>64</width><height>48"
+            '</height></original_size></task></meta><track id="0" label="person">'
+            f'<box frame="0" outside="0" occluded="0" keyframe="1" {box} z_order="0"/>'
+            "</track></annotations>\n"
+        )
+
+    def importing(name: str, text: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / name).write_text(text)
+            rec, out = good_recording(root), str(root / "imported.gt.csv")
+            return ["annotate", "import", str(root / name), "--recording", str(rec), "-o", out]
+
+        return build
+
+    def view_score_report(root: Path) -> list[str]:
+        (root / "score").mkdir()
+        (root / "score" / "report.json").write_text('{"config": {}, "sequences": [{"name": "x"}]}')
+        return ["view", str(root / "score")]
+
+    def export_to_file(root: Path) -> list[str]:
+        (root / "task").write_text("mine")
+        return ["annotate", "export", str(good_recording(root)), "-o", str(root / "task")]
+
+    return [
+        Case(
+            "cvat_box_outside",
+            "TRACEBACK",
+            importing("a.xml", cvat('xtl="50" ytl="3" xbr="90" ybr="40"')),
+            5,
+            "reaches outside the 64x48 image",
+        ),
+        Case(
+            "cvat_other_task_size",
+            "SILENT",
+            importing("a.xml", cvat(size=9)),
+            5,
+            "which no --every gives",
+        ),
+        Case(
+            "cvat_not_xml",
+            "TRACEBACK",
+            importing("a.xml", "<annotations><version>"),
+            5,
+            "not well-formed",
+        ),
+        Case(
+            "cvat_mot_without_every",
+            "WRONG-CODE",
+            importing("gt.txt", "1,1,2,3,10,37,1,1,1\n"),
+            4,
+            "give --every",
+        ),
+        Case(
+            "view_no_report",
+            "TRACEBACK",
+            lambda root: ["view", str(root)],
+            3,
+            "holds no report.json",
+        ),
+        Case(
+            "view_score_report", "TRACEBACK", view_score_report, 3, "written by `rgbd-eval score`"
+        ),
+        Case("annotate_export_to_a_file", "TRACEBACK", export_to_file, 7, "not a folder"),
+    ]
+
+
 def all_cases() -> list[Case]:
     """Every case of the corpus."""
     return [
@@ -1186,6 +1758,12 @@ def all_cases() -> list[Case]:
         *_ownership_cases(),
         *_path_and_disk_cases(),
         *_cluster_and_cache_cases(),
+        *_gt_value_cases(),
+        *_mot_value_cases(),
+        *_nesting_and_size_cases(),
+        *_recording_value_cases(),
+        *_import_cases(),
+        *_annotate_and_view_cases(),
     ]
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -265,3 +266,94 @@ def test_a_corrupt_npz_cache_entry_is_recomputed_with_one_warning(
     assert counts("s1") == counts("s2") and len(counts("s1")) == 2
     third = run_cli([*args, "--out", str(tmp_path / "s3")], capsys)
     assert third.code == 0 and "warning:" not in third.stderr
+
+
+def _run_report(
+    args: list[str], out: Path, capsys: pytest.CaptureFixture[str]
+) -> tuple[str, dict[str, Any]]:
+    """``rgbd-eval run ARGS --out OUT``: stdout and the one sequence of report.json."""
+    result = run_cli([*args, "--out", str(out)], capsys)
+    assert result.code == 0, result.stderr
+    # warnings go to stderr (issue 28), one line each: "warning: <sequence>: ..."
+    return result.stderr, json.loads((out / "report.json").read_text())["sequences"][0]
+
+
+def test_frames_outside_the_annotated_span_are_not_scored(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Ground truth of frames 0-1 of 4 is not ground truth saying frames 2-3 are empty."""
+    rec = good_recording(tmp_path)
+    first_two = tmp_path / "first2.csv"
+    write_csv(first_two, ground_truth_objects()[:2])
+    stderr, seq = _run_report(["run", str(rec), "--gt", str(first_two)], tmp_path / "a", capsys)
+    warning = "2 of 4 frames lie outside the annotated span (frames 0..1) and are not scored"
+    assert warning in " ".join(stderr.split())
+    assert any(warning in w for w in seq["warnings"])
+    assert seq["ground_truth"]["unscored_frames"] == 2
+    assert seq["ground_truth"]["scored_span"] == [0, 1]
+    assert seq["counts"]["num_gt"] == 2 and seq["counts"]["num_frames"] == 2
+    # Frames 2-3 annotated as empty (rows without id) are scored: no warning, no unscored.
+    annotated = tmp_path / "annotated.csv"
+    frames = [(o.frame, o.stamp_ns) for o in ground_truth_objects()]
+    write_csv(annotated, ground_truth_objects()[:2], frames)
+    _, seq = _run_report(["run", str(rec), "--gt", str(annotated)], tmp_path / "b", capsys)
+    assert seq["ground_truth"]["unscored_frames"] == 0 and seq["warnings"] == []
+    assert seq["counts"]["num_frames"] == FRAMES
+
+
+def test_annotated_frames_matching_no_frame_are_reported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A ground-truth stamp far in the future, or an hour's gap, leaves annotations unscored:
+    said in a warning and counted in report.json."""
+    from tests.fuzz.corpus import FAR_FUTURE_NS, gt_topic_recording
+    from tests.io.conftest import PERIOD, T0
+
+    rec = gt_topic_recording(
+        tmp_path / "fut.mcap", stamp=lambda i: T0 + i * PERIOD + (FAR_FUTURE_NS if i == 1 else 0)
+    )
+    stderr, seq = _run_report(["run", str(rec)], tmp_path / "a", capsys)
+    warning = "1 of 4 annotated frames of"
+    assert warning in stderr and "match no frame of the recording" in " ".join(stderr.split())
+    assert any(warning in w for w in seq["warnings"])
+    assert seq["ground_truth"]["unmatched_frames"] == 1 and seq["counts"]["num_gt"] == 3
+
+    objects = ground_truth_objects()
+    gap = [
+        dataclasses.replace(o, stamp_ns=o.stamp_ns + (3600 * 10**9 if o.frame >= 2 else 0))
+        for o in objects
+    ]
+    gt = tmp_path / "gap.csv"
+    write_csv(gt, gap)
+    _, seq = _run_report(
+        ["run", str(good_recording(tmp_path)), "--gt", str(gt)], tmp_path / "b", capsys
+    )
+    assert seq["ground_truth"]["unmatched_frames"] == 2
+    assert seq["ground_truth"]["unscored_frames"] == 2 and len(seq["warnings"]) == 2
+
+
+def test_some_implausible_depth_frames_are_dropped_and_reported(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def swapped(fields: dict[str, Any]) -> dict[str, Any]:
+        return {**fields, "is_bigendian": 1}  # the bytes stay little-endian
+
+    rec = damaged_ros1(tmp_path / "half.bag", lambda i: i in (1, 2), image=swapped)
+    stderr, seq = _run_report(["run", str(rec)], tmp_path / "out", capsys)
+    warning = "2 of 4 depth frames hold implausible depth, dropped"
+    assert warning in " ".join(stderr.split())
+    assert any(warning in w and "frames 1, 2" in w for w in seq["warnings"])
+    assert seq["scored"]
+
+
+def test_ground_truth_topic_frames_without_people_are_annotated(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A GroundTruthArray with nobody in it annotates its frame: the span is not cut."""
+    from tests.fuzz.corpus import gt_topic_recording
+
+    objects = ground_truth_objects()
+    rec = gt_topic_recording(tmp_path / "gt.mcap", lambda i: [objects[i]] if i == 1 else [])
+    _, seq = _run_report(["run", str(rec)], tmp_path / "out", capsys)
+    assert seq["ground_truth"]["unscored_frames"] == 0 and seq["warnings"] == []
+    assert seq["counts"]["num_frames"] == FRAMES and seq["counts"]["num_gt"] == 1

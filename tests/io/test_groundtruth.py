@@ -63,7 +63,14 @@ def test_ktp_errors(tmp_path: Path, text: str, match: str) -> None:
         (["0,1,1,0,0,1,1,,,,1"], "two stamps|two frames"),  # paired with the base row below
         (["0,100,1,0,0,1,1,,,,1"], "id 1 appears twice"),
         (["2,100,5,0,0,1,1,,,,1"], "two frames share stamp 100"),
-        (["1,200,1,0,0,-1,1,,,,1"], "line 3: negative box size"),
+        (["1,200,1,0,0,-1,1,,,,1"], "line 3: box size -1.0x1.0 is negative"),
+        (["1,200,1,0,0,-0,1,,,,1"], "line 3: box size -0.0x1.0 is negative"),
+        (["1,200,1,0,0,0,1,,,,1"], "line 3: box size 0.0x1.0 is empty"),
+        (["1,200,1,0,0,1,1e300,,,,1"], "line 3: box .* lies beyond"),
+        (["1,200,1,0,0,1,1,1e30,0,0,1"], "line 3: position .* lies beyond"),
+        (["-1,200,1,0,0,1,1,,,,1"], "line 3: frame number -1 outside"),
+        (["1,99999999999999999999,1,0,0,1,1,,,,1"], "line 3: stamp .* outside"),
+        (["1,200,,0,0,1,1,,,,1"], "line 3: a row without id .* has a box"),
         (["1,200,1,0,0,1,1,,,,1.5"], "visibility 1.5 outside"),
         (["1,200,x,0,0,1,1,,,,1"], "line 3"),
     ],
@@ -74,6 +81,39 @@ def test_csv_contradictions(tmp_path: Path, rows: list[str], match: str) -> None
     path.write_text("\n".join([header, "0,100,1,0,0,1,1,,,,1", *rows]) + "\n")
     with pytest.raises(GroundTruthError, match=match):
         groundtruth.load_ground_truth(path)
+
+
+@pytest.mark.parametrize(
+    ("text", "ignore"),
+    [("0", False), ("1", True), ("", False), ("false", False), ("FALSE", False), ("True", True)],
+)
+def test_csv_ignore_spellings(tmp_path: Path, text: str, ignore: bool) -> None:
+    path = tmp_path / "gt.csv"
+    path.write_text(",".join(groundtruth.CSV_COLUMNS) + f"\n0,100,1,0,0,1,1,,,,1,{text}\n")
+    (obj,) = groundtruth.load_ground_truth(path).frames[0][2]
+    assert obj.ignore is ignore
+
+
+@pytest.mark.parametrize("text", ["2", "no", "yes", "-1", "1.0", "x"])
+def test_csv_other_ignore_values_are_refused(tmp_path: Path, text: str) -> None:
+    path = tmp_path / "gt.csv"
+    path.write_text(",".join(groundtruth.CSV_COLUMNS) + f"\n0,100,1,0,0,1,1,,,,1,{text}\n")
+    with pytest.raises(GroundTruthError, match=f"line 2: ignore '{text}' is not 0, 1, false or"):
+        groundtruth.load_ground_truth(path)
+
+
+def test_csv_empty_frames_round_trip(tmp_path: Path) -> None:
+    """Frames annotated with nobody in them are rows with an empty id; they are annotated
+    frames (``run`` scores from the first annotated frame to the last)."""
+    path = tmp_path / "gt.csv"
+    objs = [GroundTruthObject(1, 200, 7, Box2D(0, 0, 1, 1), None)]
+    groundtruth.write_csv(path, objs, [(0, 100), (1, 200), (2, 300)])
+    gt = groundtruth.load_ground_truth(path)
+    assert [(f, s, len(o)) for f, s, o in gt.frames] == [(0, 100, 0), (1, 200, 1), (2, 300, 0)]
+    header_only = tmp_path / "empty.csv"
+    groundtruth.write_csv(header_only, [], [(0, 100)])
+    with pytest.raises(GroundTruthError, match="holds no annotated object"):
+        groundtruth.load_ground_truth(header_only)
 
 
 def test_missing_columns_and_file(tmp_path: Path) -> None:
@@ -90,11 +130,12 @@ def test_align_by_stamp_and_by_index() -> None:
     gt = groundtruth.from_objects("mem", objs)
     # Recording frames at 1005, 1195 and 5000: the third annotation (1200) matches 1195 (5 ns away),
     # the second (1100) is 95 ns from 1005 and 1195 -> over the 10 ns gap: unmatched.
-    per_frame, unmatched = gt.align([1005, 1195, 5000], max_gap_ns=10)
-    assert [len(p) for p in per_frame] == [1, 1, 0] and unmatched == 1
+    per_frame, unmatched, matched = gt.match([1005, 1195, 5000], max_gap_ns=10)
+    assert [len(p) for p in per_frame] == [1, 1, 0] and unmatched == 1 and matched == [0, 1]
     assert per_frame[1][0].frame == 2
     no_stamps = groundtruth.from_objects(
         "mem", [GroundTruthObject(1, 0, 1, Box2D(0, 0, 1, 1), None)]
     )
     per_frame, unmatched = no_stamps.align([7, 8], max_gap_ns=0)
+    assert no_stamps.match([7, 8], max_gap_ns=0)[2] == [1]
     assert [len(p) for p in per_frame] == [0, 1] and unmatched == 0

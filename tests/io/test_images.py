@@ -100,3 +100,13 @@ def test_compressed_depth_header_and_payload() -> None:
     bad = SimpleNamespace(format="16UC1; compressedDepth png", data=fields["data"][:10])
     with pytest.raises(images.ImageFormatError, match="12-byte header"):
         images.decode_depth(bad)
+
+
+def test_a_compressed_header_claiming_too_many_pixels_is_not_decoded() -> None:
+    from tests.fuzz.corpus import png_claiming
+
+    bomb = SimpleNamespace(format="png", data=np.frombuffer(png_claiming(30000, 30000), np.uint8))
+    with pytest.raises(images.ImageFormatError, match="declares 30000x30000 pixels"):
+        images.decode_color(bomb)
+    jpeg = images.encode_color_jpeg(np.zeros((48, 64, 3), np.uint8))["data"]
+    assert images.declared_size(jpeg.tobytes()) == (64, 48)

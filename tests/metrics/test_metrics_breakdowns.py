@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -257,3 +258,69 @@ def test_bands_of_several_sequences_add_up() -> None:
     near = _band(twice, "0-2 m")
     assert (near.num_gt, near.fn, near.id_switches) == (12, 2, 2)
     assert near.summary()["mota"] == pytest.approx(1 - 4 / 12)
+
+
+def test_a_run_is_analysed_on_its_annotated_span_only() -> None:
+    """``run`` scores frames 2..5 of 8 (the annotated span): the breakdowns, intervals and curve
+    take those frames only, and a switch's frame is the recording's.
+
+    GT: person 1 at (1, 0) in frames 2..5. Tracks: 10 on it in frames 2, 3, 11 in 4, 5 (a
+    switch at frame 4); track 9 at (4, 0), 3 m from it, in every frame: FPs, 4 of them in the
+    span. The camera drives along x at 1 m/s (10 Hz): every frame is 'driving'.
+    """
+    from types import SimpleNamespace
+
+    from rgbd_eval.analysis import analyse, inputs_of_run
+    from rgbd_eval.config import RunConfig
+    from rgbd_eval.pipeline import GroundTruthMatch, score_sequence
+
+    n, span = 8, (2, 5)
+    gts = [[gt(1, None, (1.0, 0.0), frame=f)] if 2 <= f <= 5 else [] for f in range(n)]
+    fp = replace(track(9, None, (4.0, 0.0)), confidence=0.2)
+    tracks = tuple(
+        (
+            *(
+                (replace(track(10 if f < 4 else 11, None, (1.0, 0.0)), confidence=0.9),)
+                if 2 <= f <= 5
+                else ()
+            ),
+            fp,
+        )
+        for f in range(n)
+    )
+    config = RunConfig(evaluation=METRIC)
+    match = GroundTruthMatch("gt.csv", gts, 4, 0, span)
+    scores = score_sequence(match, tracks, config)
+    assert (scores.counts.num_gt, scores.counts.fp, scores.counts.id_switches) == (4, 4, 1)
+    poses = []
+    for f in range(n):
+        t = np.eye(4)
+        t[:3, :3] = [[0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0]]  # optical, looking +x
+        t[0, 3] = 0.1 * f
+        poses.append(Pose.from_matrix(t))
+    result = SimpleNamespace(
+        name="part",
+        scores=scores,
+        ground_truth=match,
+        tracks=tracks,
+        detections=SimpleNamespace(
+            stamps_ns=tuple(f * STEP_NS for f in range(n)), camera_poses=tuple(poses)
+        ),
+        info=SimpleNamespace(world_frame="odom", has_odometry=True),
+    )
+    analysis = analyse(inputs_of_run([result]), METRIC, curve_points=5)  # type: ignore[list-item]
+    (part,) = analysis.sequences
+    assert part.frames == 4
+    motion = next(b for b in part.breakdowns if b.kind == bd.MOTION)
+    driving = _band(motion, "driving")
+    assert (driving.frames, driving.num_gt, driving.fp, driving.id_switches) == (4, 4, 4, 1)
+    distance = next(b for b in part.breakdowns if b.kind == bd.DISTANCE)
+    # FPs by the track's own distance: 9 is 4 - 0.1 f m away, 3.8..3.5 m in frames 2..5.
+    assert _band(distance, "2-4 m").fp == 4
+    (person,) = part.persons
+    assert person.frames == 4 and [s.frame for s in person.switches] == [4]
+    # The curve scores what was scored: at the lowest threshold, the sequence's counts.
+    assert analysis.curve is not None
+    lowest = analysis.curve.points[0]
+    assert lowest.threshold == 0.2 and lowest.overall.fp == scores.counts.fp
+    assert analysis.curve.points[-1].overall.fp == 0

@@ -119,14 +119,20 @@ def import_(
     frames: Annotated[int | None, typer.Option(help="convert only the first N frames")] = None,
 ) -> None:
     """Convert a dataset sequence folder to .mcap/.bag (depth, colour, CameraInfo, tf) + <name>.gt.csv."""
-    from rgbd_eval.io.epfl_rgbd import OWNER, annotation_path, import_sequence, scan_sequence
+    from rgbd_eval.io.epfl_rgbd import (
+        FPS_RANGE,
+        OWNER,
+        annotation_path,
+        import_sequence,
+        scan_sequence,
+    )
 
     if fmt not in FORMATS:
         raise ConfigError(f"format {fmt!r}: expected one of {', '.join(FORMATS)}")
     if out.suffix not in (".mcap", ".bag"):
         raise ConfigError(f"--out {out}: name a .mcap or .bag recording")
-    if not (math.isfinite(fps) and fps > 0):
-        raise ConfigError(f"--fps {fps}: must be a positive number")
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:  # also refuses nan
+        raise ConfigError(f"--fps {fps}: must be within {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g} Hz")
     if frames is not None and frames < 1:
         raise ConfigError(f"--frames {frames}: must be at least 1")
     if no_gt and annotations is not None:

@@ -27,7 +27,7 @@ from rgbd_eval.cli.common import (
     with_threshold,
 )
 from rgbd_eval.config import RunConfig, load_config
-from rgbd_eval.errors import InputError
+from rgbd_eval.errors import GroundTruthError, InputError
 from rgbd_eval.outdir import OutputFolder
 
 if TYPE_CHECKING:
@@ -135,11 +135,19 @@ def run(
     ] = None,
     curve: CurveOption = False,
     curve_points: CurvePointsOption = DEFAULT_CURVE_POINTS,
+    rerun: Annotated[
+        Path | None,
+        typer.Option(
+            "--rerun",
+            help="also write the run as a Rerun recording (FILE.rrd; one recording; "
+            "needs pip install 'rgbd-eval[rerun]')",
+        ),
+    ] = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.analysis import analyse, inputs_of_run
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
-    from rgbd_eval.report import REPORT_FILE, run_warnings, write_run
+    from rgbd_eval.report import REPORT_FILE, sequence_warnings, write_run
     from rgbd_eval.report_html import write_run_html
 
     sets = [*(overrides or []), *topic_overrides(topics)]
@@ -151,10 +159,20 @@ def run(
     if not inputs:
         inputs = [ensure_demo()]
     recordings = expand_inputs(inputs)
-    if gt is not None and len(recordings) > 1:
-        raise InputError(
+    if gt is not None and len(recordings) > 1:  # which recording it annotates is unknown
+        raise GroundTruthError(
             gt, "--gt applies to a single recording; use <name>.gt.csv sidecars for several"
         )
+    rrd = None
+    if rerun is not None:  # checked before any work, like the output folder
+        from rgbd_eval.rerun_log import RrdOutput
+
+        if len(recordings) > 1:
+            raise typer.BadParameter(
+                "takes one recording; for several, `rgbd-eval view` writes each run's",
+                param_hint="'--rerun'",
+            )
+        rrd = RrdOutput(rerun, "run", recordings)
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
     # What this run will write, checked against what the folder holds before any work.
@@ -195,6 +213,10 @@ def run(
                 ),
                 analysis,
             )
+    if rrd is not None:  # re-reads the recording for its images and depth, as --video does
+        with progress_bar() as bar:
+            task = bar.add_task(rrd.path.name, total=None)
+            rrd.write(results[0], config, advance_callback(bar, task))
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:
@@ -203,5 +225,10 @@ def run(
             f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
             f"(machine-readable: {out_dir / 'report.json'})"
         )
-    for line in run_warnings(results):  # also in report.json: each sequence's "warnings"
-        err_console.print(line, markup=False, highlight=False, soft_wrap=True)
+        if rrd is not None:
+            console.print(f"Rerun: rerun {rrd.path}")
+    for r in results:  # also in report.json: each sequence's "warnings"
+        for w in sequence_warnings(r):
+            err_console.print(
+                f"warning: {r.name}: {w}", markup=False, highlight=False, soft_wrap=True
+            )

@@ -17,6 +17,7 @@ from rgbd_eval.cli.common import (
     CurvePointsOption,
     SetOption,
     console,
+    err_console,
     handle_errors,
     metrics_table,
     with_threshold,
@@ -131,10 +132,12 @@ def score(
         f"convention {ev.convention.value}"
     )
     console.print(metrics_table(title, table_header(), table_rows(sequences, ev.gating)))
-    for s in sequences:
-        for w in s.warnings:
-            console.print(f"{s.name}: warning: {w}")
     console.print(
         f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
         f"(machine-readable: {out_dir / 'report.json'})"
     )
+    for s in sequences:  # also in report.json: each sequence's "warnings"
+        for w in s.warnings:
+            err_console.print(
+                f"warning: {s.name}: {w}", markup=False, highlight=False, soft_wrap=True
+            )

@@ -39,7 +39,13 @@ class Basso2012DetectorConfig(ComponentConfig):
 
     name: Literal["basso2012"] = "basso2012"
 
-    voxel_size: float = Field(0.06, gt=0.0, le=0.5, description="voxel grid side (m), Table 5.1")
+    voxel_size: float = Field(
+        0.06,
+        ge=0.01,
+        le=0.5,
+        description="voxel grid side (m), Table 5.1; at least 1 cm (finer than the Kinect's "
+        "depth noise; a tiny voxel's grid keys overflow and its clusters exhaust memory)",
+    )
     min_height: float = Field(1.4, ge=0.0, description="Table 5.1 ~people/min_height (m)")
     max_height: float = Field(2.3, gt=0.0, description="Table 5.1 ~people/max_height (m)")
     min_confidence: float = Field(-1.5, description="Table 5.1 ~people/min_confidence")
@@ -90,6 +96,7 @@ class Basso2012DetectorConfig(ComponentConfig):
     min_head_distance: float = Field(
         0.3,
         gt=0.0,
+        le=5.0,
         description="smallest ground distance (m) between two heads and the distance below "
         "which clusters are merged (Munaro et al. IROS 2012; 0.3 m in PCL's people module)",
     )

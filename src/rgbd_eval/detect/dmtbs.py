@@ -100,12 +100,17 @@ class DmtbsDetectorConfig(ComponentConfig):
         (-5.0, -5.0, 5.0, 5.0), description="floor region x_min, y_min, x_max, y_max (m)"
     )
     cell_m: float = Field(0.02, gt=0.0, le=0.2, description="density map cell side (m)")
-    blur_sigma_m: float = Field(0.02, ge=0.0, description="Gaussian blur std (seed 003, 3.3: 2 cm)")
-    density_threshold: float = Field(
-        0.5, gt=0.0, description="blob threshold on the blurred map (m^2 surface per m^2 floor)"
+    blur_sigma_m: float = Field(
+        0.02, ge=0.0, le=1.0, description="Gaussian blur std (seed 003, 3.3: 2 cm)"
     )
-    closing_radius_m: float = Field(
-        0.1, ge=0.0, description="disk radius of the closing (seed 003, 3.3: 10 cm)"
+    density_threshold: float = Field(
+        0.5,
+        gt=0.0,
+        le=1000.0,
+        description="blob threshold on the blurred map (m^2 surface per m^2 floor)",
+    )
+    closing_radius_m: float = Field(  # its kernel is (2 r / cell_m + 1)^2 cells
+        0.1, ge=0.0, le=1.0, description="disk radius of the closing (seed 003, 3.3: 10 cm)"
     )
     min_blob_area_m2: float = Field(
         0.04, ge=0.0, description="smallest blob surface kept (m^2; seed 003, 3.4: small objects)"

@@ -35,8 +35,12 @@ class PersonDetectorConfig(_Part):
     nms_iou: float = Field(0.45, gt=0.0, le=1.0, description="non-maximum suppression IoU")
     layout: Literal["auto", "v5", "v8"] = Field("auto", description="onnx: YOLO output layout")
     person_class: int = Field(0, ge=0, description="onnx: index of the person class (COCO: 0)")
-    input_size: int = Field(640, ge=32, description="onnx: input side when the model's is dynamic")
-    hog_scale: float = Field(1.05, gt=1.0, description="hog: pyramid scale factor")
+    input_size: int = Field(
+        640, ge=32, le=4096, description="onnx: input side when the model's is dynamic"
+    )
+    hog_scale: float = Field(  # closer to 1, the pyramid has more levels (1.01: ~200)
+        1.05, ge=1.01, le=2.0, description="hog: pyramid scale factor"
+    )
     source: Path | None = Field(
         None, description="recorded: the bag/.mcap holding the topic, or a det.txt"
     )
@@ -72,8 +76,8 @@ class ReidConfig(_Part):
 
     backend: ReidBackend = Field(ReidBackend.COLOUR_TEXTURE, description="embedder")
     model: Path | None = Field(None, description="onnx: the embedding network file")
-    input_width: int = Field(128, ge=1, description="onnx: network input width")
-    input_height: int = Field(256, ge=1, description="onnx: network input height")
+    input_width: int = Field(128, ge=1, le=2048, description="onnx: network input width")
+    input_height: int = Field(256, ge=1, le=2048, description="onnx: network input height")
     mean: tuple[float, float, float] = Field(
         (0.485, 0.456, 0.406), description="onnx: per-channel mean (RGB, after scaling to [0, 1])"
     )
@@ -97,7 +101,7 @@ class Pinto2022DetectorConfig(ComponentConfig):
     name: Literal["pinto2022"] = "pinto2022"
     person: PersonDetectorConfig = Field(default_factory=PersonDetectorConfig)
     reid: ReidConfig = Field(default_factory=ReidConfig)
-    threads: int = Field(1, ge=1, description="onnxruntime intra-op threads")
+    threads: int = Field(1, ge=1, le=256, description="onnxruntime intra-op threads")
 
     def appearance_kind(self) -> str:
         """The name of the embedding this config produces (thresholds are in its units)."""

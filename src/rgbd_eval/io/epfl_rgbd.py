@@ -85,6 +85,12 @@ EPFL_KINECT2 = CameraModel(
 #: The Kinect v2's nominal depth rate (issue 14 models seed 003 4.3's Kinect for Xbox One as
 #: 512x424 at 30 Hz; the seed text is cut after "512"). The folders carry no stamps.
 DEFAULT_FPS = 30.0
+#: Frame rates accepted for the stamps (Hz): a rate near 0 put the stamps past any clock
+#: (``--fps 1e-300`` overflowed).
+FPS_RANGE = (0.1, 1000.0)
+#: Largest frame number in an image name (92 hours at 30 fps): with the slowest rate the
+#: stamps stay within ROS's 32-bit seconds.
+MAX_FRAME_NUMBER = 10_000_000
 #: Annotation files are data, not configuration: allow far more values than a config YAML.
 MAX_ANNOTATION_VALUES = 20_000_000
 
@@ -159,6 +165,8 @@ def scan_sequence(folder: Path) -> EpflSequence:
         if match is None:
             continue
         kind, number = match.group(1), int(match.group(2))
+        if number > MAX_FRAME_NUMBER:
+            raise InputError(path, f"frame number {number} is above {MAX_FRAME_NUMBER}")
         table = depth if kind == "depth" else rgb
         if number in table:
             raise InputError(path, f"frame {number} twice ({table[number].name} and {path.name})")
@@ -425,8 +433,8 @@ def import_sequence(
     the floor) adds a static tf from :data:`WORLD_FRAME` and a world position per box
     (:func:`ground_position`); without it the boxes are written alone.
     """
-    if not (math.isfinite(fps) and fps > 0):
-        raise ValueError(f"fps={fps} must be a positive number")
+    if not FPS_RANGE[0] <= fps <= FPS_RANGE[1]:
+        raise ValueError(f"fps={fps} must be within {FPS_RANGE[0]:g}..{FPS_RANGE[1]:g}")
     if max_frames is not None and max_frames < 1:
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     camera = replace(camera, frame_id=CAMERA_FRAME)
@@ -440,6 +448,7 @@ def import_sequence(
     out = Path(out)
     csv_path = out.with_name(f"{out.stem}.gt.csv") if annotations is not None else None
     objects: list[GroundTruthObject] = []
+    annotated: list[tuple[int, int]] = []  # as on the topic: every frame written
     positions = 0
     if csv_path is not None:  # before any work, as the recording is (by its writer)
         check_output_file(csv_path, OWNER)
@@ -468,10 +477,11 @@ def import_sequence(
                     positions += sum(p.world_xyz is not None for p in people)
                     w.write_ground_truth(stamp, WORLD_FRAME, people)
                     objects.extend(people)
+                    annotated.append((index, stamp))
                 if progress is not None:
                     progress(index + 1, len(frames))
         if csv_path is not None:
-            write_csv(csv_path, objects, OWNER)
+            write_csv(csv_path, objects, annotated, OWNER)
     except OSError as err:  # disk full, permissions: the writer removed its temp file
         raise OutputError(out, f"cannot write ({err.strerror or err})") from err
     last = frames[-1].number

@@ -5,7 +5,11 @@ Sidecar CSV (MOTChallenge style, extended with world coordinates)::
     frame,stamp_ns,id,bb_left,bb_top,bb_width,bb_height,x,y,z,visibility,ignore
 
 ``frame`` is the recording's frame index, from 0; empty box fields mean "no box",
-empty x/y/z mean "no world position"; ``ignore`` is 0/1 and may be omitted (then 0).
+empty x/y/z mean "no world position"; ``ignore`` is ``0``/``1`` or ``false``/``true``
+(any case) and may be omitted or empty (then 0).
+A row with an empty ``id`` (and no box or position) marks a frame annotated with
+nobody in it: ``run`` scores only the frames from the first annotated frame to the
+last, so a sequence that starts or ends without people needs such rows.
 
 KTP text (Kinect Tracking Precision dataset), one line per frame::
 
@@ -32,6 +36,7 @@ import numpy as np
 from rgbd_eval.atomic import write_text
 from rgbd_eval.errors import GroundTruthError
 from rgbd_eval.files import check_input, read_text
+from rgbd_eval.io.validate import MAX_FRAME, box_problem, position_problem
 from rgbd_eval.types import Box2D, GroundTruthObject
 
 CSV_COLUMNS = (
@@ -85,19 +90,28 @@ class GroundTruth:
         When the annotations carry no stamps (all 0) they are matched by frame index.
         Returns the per-frame lists and the number of annotated frames left unmatched.
         """
+        frames, unmatched, _ = self.match(stamps_ns, max_gap_ns)
+        return frames, unmatched
+
+    def match(
+        self, stamps_ns: Sequence[int], max_gap_ns: int
+    ) -> tuple[list[list[GroundTruthObject]], int, list[int]]:
+        """:meth:`align`, and the (sorted) indices of the recording frames an annotated
+        frame matched."""
         out: list[list[GroundTruthObject]] = [[] for _ in stamps_ns]
         if not self.frames:
-            return out, 0
+            return out, 0, []
         unmatched = 0
+        taken: set[int] = set()
         if all(stamp == 0 for _, stamp, _ in self.frames):
             for index, _, objs in self.frames:
                 if 0 <= index < len(out):
                     out[index] = list(objs)
+                    taken.add(index)
                 else:
                     unmatched += 1
-            return out, unmatched
+            return out, unmatched, sorted(taken)
         rec = np.asarray(stamps_ns, dtype=np.int64)
-        taken: set[int] = set()
         for _, stamp, objs in self.frames:
             if rec.size == 0:
                 unmatched += 1
@@ -110,14 +124,61 @@ class GroundTruth:
                 taken.add(k)
             else:
                 unmatched += 1
-        return out, unmatched
+        return out, unmatched, sorted(taken)
 
 
-def _group(source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0) -> GroundTruth:
-    """Group objects by frame (indices from 0), rejecting contradictions."""
+#: Stamps are int64 nanoseconds (from 1970 to 2262).
+MAX_STAMP_NS = 2**63 - 1
+
+
+def frame_problem(frame: int, stamp_ns: int) -> str | None:
+    """Why a frame number or stamp cannot be an annotated frame's (None when they can)."""
+    if not 0 <= frame <= MAX_FRAME:
+        return f"frame number {frame} outside 0..{MAX_FRAME}"
+    if not 0 <= stamp_ns <= MAX_STAMP_NS:
+        return f"stamp {stamp_ns} ns outside 0..2**63-1"
+    return None
+
+
+def object_problem(o: GroundTruthObject) -> str | None:
+    """Why an annotation cannot be scored as given (None when it can): the values every
+    ground-truth reader must check (a topic, a CSV, KTP, MOTChallenge)."""
+    problem = frame_problem(o.frame, o.stamp_ns)
+    if problem is None and o.box2d is not None:
+        problem = box_problem(o.box2d.as_tuple())
+    if problem is None and o.world_xyz is not None:
+        problem = position_problem(o.world_xyz)
+    if problem is None and not 0.0 <= o.visibility <= 1.0:
+        problem = f"visibility {o.visibility} outside [0, 1]"
+    return problem
+
+
+def _group(
+    source: str,
+    objects: Iterable[GroundTruthObject],
+    empty: Iterable[tuple[int, int]] = (),
+    first_frame: int = 0,
+) -> GroundTruth:
+    """Group objects by frame (indices from 0), rejecting contradictions and values no
+    annotation has.
+
+    ``empty`` lists ``(frame, stamp_ns)`` of frames annotated with nobody in them;
+    ``first_frame`` is the number the source gave the first frame (kept for reports).
+    """
     by_frame: dict[int, list[GroundTruthObject]] = {}
     stamps: dict[int, int] = {}
+    for frame, stamp in empty:
+        if (problem := frame_problem(frame, stamp)) is not None:
+            raise GroundTruthError(source, problem)
+        if frame in stamps and stamps[frame] != stamp:
+            raise GroundTruthError(
+                source, f"frame {frame} has two stamps ({stamps[frame]} and {stamp})"
+            )
+        stamps[frame] = stamp
+        by_frame.setdefault(frame, [])
     for o in objects:
+        if (problem := object_problem(o)) is not None:
+            raise GroundTruthError(source, f"frame {o.frame}, id {o.object_id}: {problem}")
         if o.frame in stamps and stamps[o.frame] != o.stamp_ns:
             raise GroundTruthError(
                 source, f"frame {o.frame} has two stamps ({stamps[o.frame]} and {o.stamp_ns})"
@@ -161,6 +222,18 @@ def _id(text: str) -> int:
     return value
 
 
+#: Spellings of the ``ignore`` column (case-insensitive): anything else is refused, as "no"
+#: or "2" were silently read as "ignore".
+IGNORE_VALUES = {"": False, "0": False, "false": False, "1": True, "true": True}
+
+
+def _ignore(text: str | None) -> bool:
+    value = (text or "").strip().lower()
+    if value not in IGNORE_VALUES:
+        raise ValueError(f"ignore {text!r} is not 0, 1, false or true (or empty for 0)")
+    return IGNORE_VALUES[value]
+
+
 def _one_box(values: Sequence[float | None], what: str) -> bool:
     """True when all of ``values`` are given, False when none is; ValueError when only some are."""
     given = sum(v is not None for v in values)
@@ -174,6 +247,7 @@ def read_csv(path: Path) -> GroundTruth:
     path = Path(path)
     text = read_text(path, lambda m: GroundTruthError(path, m), "ground truth")
     objects = []
+    empty: list[tuple[int, int]] = []
     with io.StringIO(text, newline="") as handle:
         reader = csv.DictReader(handle)
         try:
@@ -203,37 +277,38 @@ def read_csv(path: Path) -> GroundTruth:
                     path, f"line {line}: more fields than the {len(fieldnames)} columns"
                 )
             try:
+                frame, stamp = int(row["frame"]), int(row["stamp_ns"] or 0)
                 box_vals = [
                     _opt_float(row[c]) for c in ("bb_left", "bb_top", "bb_width", "bb_height")
                 ]
                 xyz = [_opt_float(row[c]) for c in ("x", "y", "z")]
+                if not row["id"].strip():  # an annotated frame with nobody in it
+                    if any(v is not None for v in (*box_vals, *xyz)):
+                        raise ValueError("a row without id (an empty frame) has a box or position")
+                    empty.append((frame, stamp))
+                    continue
                 box = None
                 if _one_box(box_vals, "box"):
-                    left, top, width, height = (float(v) for v in box_vals if v is not None)
-                    if width < 0 or height < 0:
-                        raise ValueError(f"negative box size {width}x{height}")
-                    box = Box2D(left, top, width, height) if width > 0 and height > 0 else None
+                    box = Box2D(*(float(v) for v in box_vals if v is not None))
                 world = None
                 if _one_box(xyz, "x/y/z"):
                     world = (float(xyz[0] or 0.0), float(xyz[1] or 0.0), float(xyz[2] or 0.0))
                 visibility = float(row["visibility"]) if row["visibility"].strip() else 1.0
-                if not 0.0 <= visibility <= 1.0:
-                    raise ValueError(f"visibility {visibility} outside [0, 1]")
-                ignore_text = (row.get("ignore") or "0").strip()
-                objects.append(
-                    GroundTruthObject(
-                        frame=int(row["frame"]),
-                        stamp_ns=int(row["stamp_ns"] or 0),
-                        object_id=_id(row["id"]),
-                        box2d=box,
-                        world_xyz=world,
-                        visibility=visibility,
-                        ignore=ignore_text not in ("", "0", "false", "False"),
-                    )
+                obj = GroundTruthObject(
+                    frame=frame,
+                    stamp_ns=stamp,
+                    object_id=_id(row["id"]),
+                    box2d=box,
+                    world_xyz=world,
+                    visibility=visibility,
+                    ignore=_ignore(row.get("ignore")),
                 )
+                if (problem := object_problem(obj)) is not None:
+                    raise ValueError(problem)
+                objects.append(obj)
             except (ValueError, TypeError) as err:
                 raise GroundTruthError(path, f"line {line}: {err}") from err
-    return _group(str(path), objects)
+    return _group(str(path), objects, empty)
 
 
 def _fmt(value: float | None) -> str:
@@ -242,27 +317,44 @@ def _fmt(value: float | None) -> str:
     return repr(float(value))
 
 
-def write_csv(path: Path, objects: Iterable[GroundTruthObject], owner: str | None = None) -> None:
-    """Write the sidecar CSV atomically (temp file, then rename); with ``owner`` (the
-    command) it replaces only a sidecar that command wrote (:func:`rgbd_eval.atomic.write_bytes`).
+def write_csv(
+    path: Path,
+    objects: Iterable[GroundTruthObject],
+    frames: Iterable[tuple[int, int]] = (),
+    owner: str | None = None,
+) -> None:
+    """Write the sidecar CSV atomically (temp file, then rename).
+
+    ``frames`` lists ``(frame, stamp_ns)`` of every annotated frame: those without an
+    object get a row with an empty id (annotated, nobody there). With ``owner`` (the
+    command) it replaces only a sidecar that command wrote
+    (:func:`rgbd_eval.atomic.write_bytes`).
     """
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\r\n")
-    writer.writerow(CSV_COLUMNS)
+    rows: list[tuple[int, list[object]]] = []
     for o in objects:
         box: tuple[float | None, ...] = o.box2d.as_tuple() if o.box2d else (None,) * 4
         xyz: tuple[float | None, ...] = o.world_xyz if o.world_xyz else (None,) * 3
-        writer.writerow(
-            [
+        rows.append(
+            (
                 o.frame,
-                o.stamp_ns,
-                o.object_id,
-                *(_fmt(v) for v in box),
-                *(_fmt(v) for v in xyz),
-                _fmt(o.visibility),
-                int(o.ignore),
-            ]
+                [
+                    o.frame,
+                    o.stamp_ns,
+                    o.object_id,
+                    *(_fmt(v) for v in box),
+                    *(_fmt(v) for v in xyz),
+                    _fmt(o.visibility),
+                    int(o.ignore),
+                ],
+            )
         )
+    occupied = {frame for frame, _ in rows}
+    rows += [(f, [f, s, *[""] * (len(CSV_COLUMNS) - 2)]) for f, s in frames if f not in occupied]
+    rows.sort(key=lambda r: r[0])  # stable: objects keep their order within a frame
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\r\n")
+    writer.writerow(CSV_COLUMNS)
+    writer.writerows(row for _, row in rows)
     write_text(Path(path), buf.getvalue(), owner)
 
 
@@ -282,6 +374,7 @@ def read_ktp(path: Path) -> GroundTruth:
     path = Path(path)
     lines = read_text(path, lambda m: GroundTruthError(path, m), "ground truth").splitlines()
     objects = []
+    annotated: list[tuple[int, int]] = []  # every line is a frame, people in it or not
     arity: int | None = None
     frame = -1
     for number, line in enumerate(lines, start=1):
@@ -295,6 +388,9 @@ def read_ktp(path: Path) -> GroundTruth:
         except InvalidOperation as err:
             raise GroundTruthError(path, f"line {number}: bad stamp {head.strip()!r}") from err
         frame += 1
+        if (problem := frame_problem(frame, stamp)) is not None:
+            raise GroundTruthError(path, f"line {number}: {problem}")
+        annotated.append((frame, stamp))
         for entry in filter(None, (e.strip() for e in rest.split(","))):
             values = entry.split()
             if len(values) not in (4, 5):
@@ -315,31 +411,32 @@ def read_ktp(path: Path) -> GroundTruth:
                 raise GroundTruthError(path, f"line {number}: entry {entry!r} is not finite")
             if all(v == 0.0 for v in nums):
                 continue  # 0 0 0 (0) means the person is not annotated in this frame
-            if arity == 5 and (nums[2] < 0 or nums[3] < 0):
-                raise GroundTruthError(
-                    path, f"line {number}: entry {entry!r} has a negative box width or height"
-                )
             if arity == 5:
                 obj = GroundTruthObject(frame, stamp, oid, Box2D(*nums), None)
             else:
                 obj = GroundTruthObject(frame, stamp, oid, None, (nums[0], nums[1], nums[2]))
+            if (problem := object_problem(obj)) is not None:
+                raise GroundTruthError(path, f"line {number}: entry {entry!r}: {problem}")
             objects.append(obj)
-    return _group(str(path), objects)
+    return _group(str(path), objects, annotated)
 
 
 # ----------------------------------------------------------------------------- topic
 
 
 def objects_from_message(msg: Any, frame: int, stamp_ns: int) -> list[GroundTruthObject]:
-    """Objects of one ``rgbd_eval_msgs/GroundTruthArray`` message."""
+    """Objects of one ``rgbd_eval_msgs/GroundTruthArray`` message.
+
+    A person without a box has ``bb_width = bb_height = 0``, without a position
+    ``x = y = z = NaN`` (as :class:`~rgbd_eval.io.writer.RecordingWriter` writes them);
+    any other value is the box or position, checked when the frames are grouped.
+    """
     out = []
     for p in msg.people:
-        box = (
-            Box2D(p.bb_left, p.bb_top, p.bb_width, p.bb_height)
-            if p.bb_width > 0 and p.bb_height > 0
-            else None
-        )
-        world = None if math.isnan(p.x) else (float(p.x), float(p.y), float(p.z))
+        values = (float(p.bb_left), float(p.bb_top), float(p.bb_width), float(p.bb_height))
+        box = None if values[2] == 0 and values[3] == 0 else Box2D(*values)
+        xyz = (float(p.x), float(p.y), float(p.z))
+        world = None if all(math.isnan(v) for v in xyz) else xyz
         if box is None and world is None:
             continue
         out.append(
@@ -351,21 +448,34 @@ def objects_from_message(msg: Any, frame: int, stamp_ns: int) -> list[GroundTrut
 
 
 def from_objects(
-    source: str, objects: Iterable[GroundTruthObject], first_frame: int = 0
+    source: str,
+    objects: Iterable[GroundTruthObject],
+    empty: Iterable[tuple[int, int]] = (),
+    first_frame: int = 0,
 ) -> GroundTruth:
     """Group already decoded objects (frames from 0; e.g. from the ground-truth topic).
 
+    ``empty`` lists ``(frame, stamp_ns)`` of frames annotated with nobody in them;
     ``first_frame`` is the number their source gave the first frame (kept for reports).
     """
-    return _group(source, objects, first_frame)
+    return _group(source, objects, empty, first_frame)
+
+
+def require_objects(gt: GroundTruth) -> GroundTruth:
+    """``gt``, or a GroundTruthError when it annotates nobody (an empty file, a header):
+    scoring it would call every track a false positive."""
+    if gt.num_objects == 0:
+        raise GroundTruthError(gt.source, "holds no annotated object (empty, or only a header?)")
+    return gt
 
 
 def load_ground_truth(path: Path) -> GroundTruth:
-    """Load a sidecar CSV (``.csv``) or a KTP text file (anything else)."""
+    """Load a sidecar CSV (``.csv``) or a KTP text file (anything else); it must annotate
+    somebody."""
     path = Path(path)
     if not path.exists():
         raise GroundTruthError(path, "ground-truth file not found")
     check_input(path, lambda m: GroundTruthError(path, m), "ground truth")
     if path.suffix.lower() == ".csv":
-        return read_csv(path)
-    return read_ktp(path)
+        return require_objects(read_csv(path))
+    return require_objects(read_ktp(path))

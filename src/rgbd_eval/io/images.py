@@ -42,6 +42,54 @@ class ImageFormatError(ValueError):
     """An image message cannot be decoded; the reader adds file and topic."""
 
 
+#: Most pixels a compressed image may declare before it is decoded (an 8K frame has 33
+#: million): the decoder allocates what the header says, and a few bytes can say 30000^2.
+MAX_COMPRESSED_PIXELS = 1 << 25
+_PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+#: JPEG start-of-frame markers (baseline, progressive, ...): height and width follow.
+_JPEG_SOF = frozenset(
+    {0xC0, 0xC1, 0xC2, 0xC3, 0xC5, 0xC6, 0xC7, 0xC9, 0xCA, 0xCB, 0xCD, 0xCE, 0xCF}
+)
+
+
+def declared_size(data: bytes) -> tuple[int, int] | None:
+    """``(width, height)`` a PNG or JPEG stream declares in its header (None: not found)."""
+    if data.startswith(_PNG_MAGIC) and len(data) >= 24 and data[12:16] == b"IHDR":
+        width, height = struct.unpack_from(">II", data, 16)
+        return int(width), int(height)
+    if not data.startswith(b"\xff\xd8"):
+        return None
+    pos = 2
+    while pos + 4 <= len(data):
+        if data[pos] != 0xFF:
+            return None
+        marker = data[pos + 1]
+        if marker == 0xFF:  # fill byte
+            pos += 1
+            continue
+        if marker in (0x01, *range(0xD0, 0xD9)):  # no length
+            pos += 2
+            continue
+        (length,) = struct.unpack_from(">H", data, pos + 2)
+        if marker in _JPEG_SOF and pos + 9 <= len(data):
+            height, width = struct.unpack_from(">HH", data, pos + 5)
+            return int(width), int(height)
+        pos += 2 + length
+    return None
+
+
+def _imdecode(buf: NDArray[np.uint8], flags: int, what: str) -> NDArray[Any] | None:
+    """``cv2.imdecode`` once the header's size is bounded (None when it does not decode)."""
+    size = declared_size(buf[: 1 << 18].tobytes())  # the header, past any EXIF block
+    if size is not None and size[0] * size[1] > MAX_COMPRESSED_PIXELS:
+        raise ImageFormatError(
+            f"{what} declares {size[0]}x{size[1]} pixels, more than the "
+            f"{MAX_COMPRESSED_PIXELS} an image may have"
+        )
+    decoded: NDArray[Any] | None = cv2.imdecode(buf, flags)
+    return decoded
+
+
 def bytes_per_pixel(encoding: str) -> tuple[int, int]:
     """``(channels, bytes per channel)`` of a raw ``Image`` encoding (ImageFormatError if unknown)."""
     channels, kind = _pixel_layout(encoding)
@@ -87,7 +135,7 @@ def decode_color(msg: Any) -> NDArray[np.uint8]:
     """Decode an RGB ``Image`` or ``CompressedImage`` to ``HxWx3`` RGB."""
     if hasattr(msg, "format"):
         buf = np.asarray(msg.data, dtype=np.uint8)
-        bgr = cv2.imdecode(buf, cv2.IMREAD_COLOR)
+        bgr = _imdecode(buf, cv2.IMREAD_COLOR, f"compressed image ({msg.format!r})")
         if bgr is None:
             raise ImageFormatError(f"compressed image ({msg.format!r}) could not be decoded")
         # In place, and ~40x faster than copying the reversed-channel view.
@@ -108,7 +156,7 @@ def decode_mono(msg: Any) -> NDArray[Any]:
     to its raw counts (``uint8`` or ``uint16``): thermal and grey cameras."""
     if hasattr(msg, "format"):
         buf = np.asarray(msg.data, dtype=np.uint8)
-        img = cv2.imdecode(buf, cv2.IMREAD_UNCHANGED)
+        img = _imdecode(buf, cv2.IMREAD_UNCHANGED, f"compressed image ({msg.format!r})")
         if img is None:
             raise ImageFormatError(f"compressed image ({msg.format!r}) could not be decoded")
         if img.ndim == 3:
@@ -142,7 +190,7 @@ def decode_depth(msg: Any) -> NDArray[np.float32]:
             raise ImageFormatError("compressedDepth message shorter than its 12-byte header")
         _, quant_a, quant_b = _COMPRESSED_DEPTH_HEADER.unpack_from(raw)
         png = np.frombuffer(raw, dtype=np.uint8, offset=_COMPRESSED_DEPTH_HEADER.size)
-        img = cv2.imdecode(png, cv2.IMREAD_UNCHANGED)
+        img = _imdecode(png, cv2.IMREAD_UNCHANGED, "compressedDepth payload")
         if img is None or img.dtype != np.uint16 or img.ndim != 2:
             raise ImageFormatError("compressedDepth payload is not a 16-bit single-channel PNG")
         if fmt.startswith("32FC1"):

@@ -11,8 +11,10 @@ message it uses in its index pass, whatever the container:
   the message definition), and its size must be that of its CameraInfo;
 - a ``sensor_msgs/CompressedImage`` must hold data (``compressedDepth``: more than its
   12-byte header);
-- a ``sensor_msgs/CameraInfo`` must describe a camera: positive size, a finite ``K`` with
-  positive focal lengths (an uncalibrated driver publishes ``K`` all zero), finite ``D``.
+- a ``sensor_msgs/CameraInfo`` must describe a camera: a size of 1 to 16384 pixels a side,
+  a finite ``K`` with positive focal lengths (an uncalibrated driver publishes ``K`` all
+  zero) giving a field of view of 1 to 170 degrees, the principal point within one image
+  size of the image, finite ``D``.
 
 A message that fails is skipped and counted per topic (:class:`SkipLog`); the counts go
 into a warning, ``report.json`` and ``inspect``. When nothing usable is left (no valid
@@ -29,6 +31,12 @@ from rgbd_eval.io.images import ImageFormatError, bytes_per_pixel
 
 #: ``compressedDepth`` payloads start with ``int32 format, float32 A, float32 B``.
 _COMPRESSED_DEPTH_HEADER = 12
+#: Largest image side a CameraInfo may state (pixels): sizes are allocated from it.
+MAX_IMAGE_SIDE = 16384
+#: Field of view (degrees, per axis, from the focal length) a pinhole camera may have: a
+#: focal length of 1e-300 pixels (a view of 180 degrees) made every back-projected point
+#: land at infinity.
+FOV_RANGE_DEG = (1.0, 170.0)
 
 
 @dataclass(frozen=True)
@@ -76,14 +84,25 @@ def camera_info_problem(msg: Any) -> str | None:
     K = list(msg.K if hasattr(msg, "K") else msg.k)
     D = list(msg.D if hasattr(msg, "D") else msg.d)
     width, height = int(msg.width), int(msg.height)
-    if width <= 0 or height <= 0:
-        return f"CameraInfo size is {width}x{height}"
+    if not (0 < width <= MAX_IMAGE_SIDE and 0 < height <= MAX_IMAGE_SIDE):
+        return f"CameraInfo size is {width}x{height} (sides of 1 to {MAX_IMAGE_SIDE} pixels)"
     if len(K) != 9 or not _finite(K):
         return f"CameraInfo K is not 9 finite numbers: {K}"
     if not any(K):
         return "CameraInfo K is all zero (uncalibrated camera)"
-    if not (K[0] > 0 and K[4] > 0):
-        return f"CameraInfo focal lengths must be positive, K has fx={K[0]}, fy={K[4]}"
+    fx, cx, fy, cy = float(K[0]), float(K[2]), float(K[4]), float(K[5])
+    if not (fx > 0 and fy > 0):
+        return f"CameraInfo focal lengths must be positive, K has fx={fx}, fy={fy}"
+    low, high = FOV_RANGE_DEG
+    for axis, focal, side in (("x", fx, width), ("y", fy, height)):
+        fov = math.degrees(2.0 * math.atan(side / (2.0 * focal)))
+        if not low <= fov <= high:
+            return (
+                f"CameraInfo f{axis}={focal:g} gives a {fov:.4g} degree field of view over "
+                f"{side} pixels, outside {low:g}..{high:g}"
+            )
+    if not (-width <= cx <= 2 * width and -height <= cy <= 2 * height):
+        return f"CameraInfo principal point ({cx:g}, {cy:g}) lies far outside the {width}x{height} image"
     if not _finite(D):
         return f"CameraInfo D is not finite: {D}"
     return None

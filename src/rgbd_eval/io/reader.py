@@ -274,6 +274,8 @@ class _Index:
     tf: TfBuffer = field(default_factory=TfBuffer)
     odom_frames: tuple[str, str] | None = None
     gt_objects: list[Any] = field(default_factory=list)
+    #: (frame, stamp) of every ground-truth message: annotated frames, people in them or not.
+    gt_frames: list[tuple[int, int]] = field(default_factory=list)
     gt_messages: int = 0
     #: The recording's provenance (:mod:`rgbd_eval.io.provenance`), when it has one.
     provenance: dict[str, Any] | None = None
@@ -315,12 +317,22 @@ class Recording:
         # Per stream topic, every message's log time in reading order (see frames()).
         self._log_ns = dict(log_ns or {})
         self.empty_depth_frames: list[int] = []  # indices, filled while frames() runs
+        # Indices of depth frames dropped as implausible, and the first one's reason.
+        self.implausible_depth_frames: list[int] = []
+        self.implausible_depth_problem = ""
 
     @property
     def frame_warnings(self) -> tuple[str, ...]:
-        """Warnings found while decoding (after :meth:`frames` ran): empty depth frames."""
-        warning = validate.empty_depth_warning(self.empty_depth_frames, len(self._plan))
-        return () if warning is None else (warning,)
+        """Warnings found while decoding (after :meth:`frames` ran): empty depth frames,
+        and depth frames dropped as implausible."""
+        total = len(self._plan)
+        warnings = (
+            validate.empty_depth_warning(self.empty_depth_frames, total),
+            validate.implausible_depth_warning(
+                self.implausible_depth_frames, total, self.implausible_depth_problem
+            ),
+        )
+        return tuple(w for w in warnings if w is not None)
 
     def __len__(self) -> int:
         return len(self._plan)
@@ -344,6 +356,7 @@ class Recording:
             raise ValueError(f"frame range {start}:{stop} outside 0:{len(self._plan)}")
         if start == stop:
             self.empty_depth_frames = []
+            self.implausible_depth_frames = []
             return
         sel = self.info.selected.streams
         by_topic = {topic: role for role, topic in sel.items()}
@@ -356,6 +369,7 @@ class Recording:
         primary = "depth" if "depth" in sel else next(iter(sel))
         next_k = start
         self.empty_depth_frames = []
+        self.implausible_depth_frames = []
         info = self.info
         try:
             with open_source(self.path) as src:
@@ -372,8 +386,8 @@ class Recording:
                     else:
                         msg = src.deserialize(raw, msgtypes[topic])
                         decoded = self._decode(msg, topic, role, info.cameras[role])
-                        if role == "depth" and validate.depth_is_empty(decoded[0]):
-                            self.empty_depth_frames.append(k)
+                        if role == "depth":
+                            decoded = self._check_depth(decoded, k)
                     ready.setdefault(k, {})[role] = decoded
                     while len(ready.get(next_k, ())) == len(sel):
                         plan = self._plan[next_k]
@@ -406,8 +420,23 @@ class Recording:
             raise InputError(
                 self.path, f"recording ended after {next_k} of {len(self._plan)} indexed frames"
             )
-        if next_k and len(self.empty_depth_frames) == len(self._plan):
+        unusable = len(self.empty_depth_frames) + len(self.implausible_depth_frames)
+        if next_k and unusable == len(self._plan):
             raise self.no_depth_error()
+
+    def _check_depth(self, decoded: tuple[Any, str], k: int) -> tuple[Any, str]:
+        """The decoded depth of frame ``k``, noted when empty; all NaN (dropped, noted) when
+        implausible."""
+        depth, encoding = decoded
+        problem = validate.implausible_depth(depth)
+        if problem is not None:
+            if not self.implausible_depth_frames:
+                self.implausible_depth_problem = problem
+            self.implausible_depth_frames.append(k)
+            return np.full_like(depth, np.nan), encoding
+        if validate.depth_is_empty(depth):
+            self.empty_depth_frames.append(k)
+        return decoded
 
     def _resume_at(self, first: Mapping[str, int]) -> tuple[int | None, dict[str, int]]:
         """Where to start reading for messages ``first[topic]`` on (positions among the
@@ -432,11 +461,18 @@ class Recording:
             topic: int(np.searchsorted(t, start, side="left")) for topic, t in times.items()
         }
 
-    def no_depth_error(self) -> DecodeError:
-        """The error of a recording none of whose depth frames holds a valid pixel."""
-        return DecodeError(
-            self.path, "no depth frame holds a valid pixel", self.info.selected.streams["depth"]
+    def no_depth_error(self, implausible: str | None = None) -> DecodeError:
+        """The error of a recording none of whose depth frames holds a valid (plausible)
+        pixel; ``implausible``: why a frame was dropped, when known from another pass."""
+        topic = self.info.selected.streams["depth"]
+        problem = implausible or (
+            self.implausible_depth_problem if self.implausible_depth_frames else None
         )
+        if problem is not None:
+            return DecodeError(
+                self.path, f"no depth frame holds plausible depth ({problem})", topic
+            )
+        return DecodeError(self.path, "no depth frame holds a valid pixel", topic)
 
     def _decode(self, msg: Any, topic: str, role: str, camera: CameraModel) -> tuple[Any, str]:
         kind = role_kind(role)
@@ -816,6 +852,11 @@ def open_recording(
     primary = "depth" if "depth" in chosen else reference
     camera_frame = cameras[primary].frame_id or chosen[primary]
     world_frame, has_odometry, chain = _world(path, io, index, camera_frame, odom_topic, warnings)
+    jump = index.tf.jump_problem(chain) if has_odometry else None
+    if jump is not None:
+        child, jump_message = jump
+        by_odometry = index.odom_frames is not None and index.odom_frames[1] == child
+        raise TransformError(path, jump_message, odom_topic if by_odometry else None)
     colour, depth = cameras.get("colour"), cameras.get("depth")
     depth_to_rgb = (
         _depth_to_rgb(index.tf, colour, depth, warnings)
@@ -875,9 +916,9 @@ def open_recording(
     gt = None
     if gt_topic is not None:
         try:
-            gt = groundtruth.from_objects(f"{path}:{gt_topic}", index.gt_objects)
-        except GroundTruthError as err:
-            raise InputError(path, str(err), gt_topic) from err
+            gt = groundtruth.from_objects(f"{path}:{gt_topic}", index.gt_objects, index.gt_frames)
+        except GroundTruthError as err:  # bad ground truth (exit 5), not a bad recording
+            raise GroundTruthError(path, err.message, gt_topic) from err
 
     ref_sync = StreamSync(
         reference,
@@ -1098,6 +1139,7 @@ def _index_pass(path: Path, src: MessageSource, sel: SelectedTopics, io: IoConfi
         elif topic == sel.ground_truth:
             frame = index.gt_messages
             index.gt_messages += 1
+            index.gt_frames.append((frame, _stamp_of(msg)))
             index.gt_objects.extend(groundtruth.objects_from_message(msg, frame, _stamp_of(msg)))
     return index
 

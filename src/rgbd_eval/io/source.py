@@ -30,6 +30,8 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from rosbags.typesys.base import TypesysError
 from rosbags.typesys.store import Typestore
 
+from rgbd_eval.errors import InputError
+from rgbd_eval.files import check_folder, parse_yaml, read_text
 from rgbd_eval.io.messages import typestore
 
 #: Exceptions the underlying readers raise on broken files; the reader maps them to InputError.
@@ -281,8 +283,29 @@ def _schema_store(schemas: tuple[tuple[str, bytes], ...]) -> Typestore:
     return store
 
 
+#: Largest ROS2 ``metadata.yaml`` read (a long bag's lists a few thousand files).
+MAX_METADATA_BYTES = 16 << 20
+
+
+def check_bag_folder(path: Path) -> None:
+    """InputError unless a ROS2 bag folder holds only regular files and folders (a named
+    pipe as ``metadata.yaml`` or ``.db3`` blocked the reader forever) and its
+    ``metadata.yaml`` is bounded, non-bomb YAML (rosbags parses it without bounds)."""
+
+    def error(message: str) -> InputError:
+        return InputError(path, message)
+
+    check_folder(path, error, "ROS2 bag folder")
+    metadata = path / "metadata.yaml"
+    if metadata.exists():
+        text = read_text(metadata, error, "metadata.yaml", MAX_METADATA_BYTES)
+        parse_yaml(text, lambda m: error(f"metadata.yaml: {m}"))
+
+
 def open_source(path: Path) -> MessageSource:
     """The fastest source for ``path`` (see the module docstring)."""
     if path.suffix == ".mcap" and path.is_file():
         return McapSource(path)
+    if path.is_dir():
+        check_bag_folder(path)
     return AnyReaderSource(path)

@@ -7,6 +7,7 @@ from itertools import pairwise
 
 import numpy as np
 
+from rgbd_eval.io.validate import MAX_POSITION_M
 from rgbd_eval.types import FloatArray, Pose
 
 
@@ -34,12 +35,23 @@ def slerp(q0: FloatArray, q1: FloatArray, t: float) -> FloatArray:
 QUATERNION_NORM_TOLERANCE = 0.1
 
 
+#: Fastest motion between two consecutive transforms of a moving frame (odometry): 20 m/s
+#: (72 km/h) is beyond any robot an RGB-D people tracker rides on. A larger step is a
+#: corrupt message, a reset or a teleport, and every pose interpolated across it is wrong.
+MAX_SPEED_M_S = 20.0
+#: Step allowed on top of MAX_SPEED_M_S x the time between the two transforms (noise, and
+#: two messages with one stamp).
+JUMP_SLACK_M = 0.1
+
+
 def pose_problem(pose: Pose) -> str | None:
     """Why ``pose`` cannot be a recorded transform (None when it can)."""
     t = np.asarray(pose.translation, dtype=np.float64)
     q = np.asarray(pose.rotation, dtype=np.float64)
     if not np.all(np.isfinite(t)):
         return f"position {tuple(float(v) for v in t)} is not finite"
+    if float(np.max(np.abs(t))) > MAX_POSITION_M:
+        return f"position {tuple(float(v) for v in t)} lies beyond {MAX_POSITION_M:g} m"
     if not np.all(np.isfinite(q)):
         return f"quaternion {tuple(float(v) for v in q)} is not finite"
     norm = float(np.linalg.norm(q))
@@ -163,6 +175,30 @@ class TfBuffer:
             (float(p[0]), float(p[1]), float(p[2])),
             (float(q[0]), float(q[1]), float(q[2]), float(q[3])),
         )
+
+    def jump_problem(self, frames: list[str]) -> tuple[str, str] | None:
+        """``(child frame, why)`` of the first impossible step of a moving transform along
+        ``frames`` (a chain), if any.
+
+        Between two consecutive transforms (by stamp) of a moving edge, the child may move
+        at most ``MAX_SPEED_M_S`` x the time between them, plus ``JUMP_SLACK_M``.
+        """
+        for child in frames:
+            edge = self._edges.get(child)
+            if edge is None or edge.static or len(edge.stamps) < 2:
+                continue
+            stamps, trans, _ = edge.arrays()
+            step = np.linalg.norm(np.diff(trans, axis=0), axis=1)
+            dt = np.diff(stamps).astype(np.float64) / 1e9
+            bad = np.flatnonzero(step > MAX_SPEED_M_S * dt + JUMP_SLACK_M)
+            if bad.size:
+                k = int(bad[0])
+                return child, (
+                    f"{edge.parent}->{child} moves {step[k]:.3g} m in {dt[k] * 1e3:.3g} ms "
+                    f"(at stamp {int(stamps[k + 1])} ns): faster than {MAX_SPEED_M_S:g} m/s, "
+                    "a corrupt, reset or teleporting pose"
+                )
+        return None
 
     def lookup(self, target: str, source: str, stamp_ns: int, tolerance_ns: int = 0) -> Pose:
         """``target_T_source`` at ``stamp_ns``, interpolated; held up to ``tolerance_ns`` past the ends."""

@@ -30,15 +30,26 @@ from __future__ import annotations
 import configparser
 import csv
 import enum
+import io
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from rgbd_eval.errors import GroundTruthError, InputError
-from rgbd_eval.files import check_input
-from rgbd_eval.io.groundtruth import GroundTruth, from_objects, load_ground_truth, read_ktp
+from rgbd_eval.errors import GroundTruthError, InputError, RgbdEvalError
+from rgbd_eval.files import read_text
+from rgbd_eval.io.groundtruth import (
+    MAX_ID,
+    GroundTruth,
+    frame_problem,
+    from_objects,
+    load_ground_truth,
+    read_ktp,
+    require_objects,
+)
+from rgbd_eval.io.validate import MAX_FRAME, MAX_PIXELS, position_problem
 from rgbd_eval.types import Box2D, GroundTruthObject, Pose, TrackOutput, Visibility
 
 
@@ -90,23 +101,32 @@ class Aligned:
 
 # ----------------------------------------------------------------------------- detection
 
+#: Builds the error of one input (GroundTruthError for ground truth, InputError for tracks).
+Err = Callable[[str], RgbdEvalError]
 
-def _first_data_line(path: Path) -> str:
-    try:
-        with path.open(encoding="utf-8") as handle:
-            for line in handle:
-                if line.strip() and not line.lstrip().startswith("#"):
-                    return line.strip()
-    except OSError as err:
-        raise InputError(path, f"cannot read ({err.strerror})") from err
-    except UnicodeDecodeError as err:
-        raise InputError(path, "not a text file") from err
+#: Longest timeline of frames scored by frame number (MOTChallenge text, ``seqinfo.ini``):
+#: 55 minutes at 30 fps; MOTChallenge's longest sequence has 3,315 frames. Scoring costs
+#: about 0.25 ms a frame, empty or not, so a frame number of 10^8 was a MemoryError.
+MAX_TIMELINE_FRAMES = 100_000
+
+
+def _gt_error(path: Path) -> Err:
+    return lambda message: GroundTruthError(path, message)
+
+
+def _tracks_error(path: Path) -> Err:
+    return lambda message: InputError(path, message)
+
+
+def _first_data_line(text: str) -> str:
+    for line in text.splitlines():
+        if line.strip() and not line.lstrip().startswith("#"):
+            return line.strip()
     return ""
 
 
-def is_mot_text(path: Path) -> bool:
-    """Whether a file looks like MOTChallenge text (comma-separated numbers, no header)."""
-    fields = _first_data_line(Path(path)).split(",")
+def _looks_like_mot(text: str) -> bool:
+    fields = _first_data_line(text).split(",")
     if len(fields) < 6:
         return False
     try:
@@ -116,60 +136,82 @@ def is_mot_text(path: Path) -> bool:
     return True
 
 
+def is_mot_text(path: Path) -> bool:
+    """Whether a file looks like MOTChallenge text (comma-separated numbers, no header)."""
+    path = Path(path)
+    return _looks_like_mot(read_text(path, _tracks_error(path), "tracker output"))
+
+
 # ----------------------------------------------------------------------------- MOTChallenge
 
 
-def _mot_rows(path: Path, what: type[Exception]) -> np.ndarray:
+def _mot_rows(text: str, error: Err) -> np.ndarray:
+    """The rows of MOTChallenge text, every value the readers take on trust checked:
+    frame and id whole numbers in range, finite box values within image coordinates."""
     try:
-        rows = np.loadtxt(path, delimiter=",", ndmin=2, dtype=np.float64)
-    except (OSError, ValueError) as err:
-        message = f"not MOTChallenge text ({err})"
-        raise (
-            GroundTruthError(path, message)
-            if what is GroundTruthError
-            else InputError(path, message)
-        ) from err
+        rows = np.loadtxt(io.StringIO(text), delimiter=",", ndmin=2, dtype=np.float64)
+    except ValueError as err:
+        raise error(f"not MOTChallenge text ({' '.join(str(err).split())[:200]})") from err
     if rows.size and rows.shape[1] < 6:
-        raise (
-            what(path, "MOTChallenge text needs at least 6 columns")
-            if what is not GroundTruthError
-            else GroundTruthError(path, "MOTChallenge text needs at least 6 columns")
-        )
-    if rows.size and not np.isfinite(rows[:, :6]).all():
-        raise InputError(path, "non-finite frame, id or box value")
-    if rows.size and rows[:, 0].min() < MOT_FIRST_FRAME:
-        message = (
+        raise error("MOTChallenge text needs at least 6 columns")
+    if not rows.size:
+        return rows
+    if not np.isfinite(rows[:, :6]).all():
+        raise error("non-finite frame, id or box value")
+    if rows[:, 0].min() < MOT_FIRST_FRAME:
+        raise error(
             f"frame {rows[:, 0].min():g}: MOTChallenge frames count from {MOT_FIRST_FRAME} "
             "(a file numbered from 0 would be scored one frame off)"
         )
-        raise GroundTruthError(path, message) if what is GroundTruthError else what(path, message)
+    for column, what, low, high in ((0, "frame", 0, MAX_FRAME), (1, "id", -MAX_ID, MAX_ID)):
+        values = rows[:, column]
+        bad = np.flatnonzero((values != np.round(values)) | (values < low) | (values > high))
+        if bad.size:
+            k = int(bad[0])
+            raise error(f"row {k + 1}: {what} {values[k]:g} is not a whole number in {low}..{high}")
+    boxes = rows[:, 2:6]
+    bad = np.flatnonzero((np.abs(boxes) > MAX_PIXELS).any(axis=1))
+    if bad.size:
+        k = int(bad[0])
+        raise error(f"row {k + 1}: box {tuple(boxes[k])} lies beyond {MAX_PIXELS:g} pixels")
     return rows
 
 
 def seq_length(gt_path: Path) -> int | None:
-    """``seqLength`` from the ``seqinfo.ini`` of a MOTChallenge sequence folder, if any."""
+    """``seqLength`` from the ``seqinfo.ini`` of a MOTChallenge sequence folder, if any
+    (1..:data:`MAX_TIMELINE_FRAMES`)."""
     for folder in (gt_path.parent, gt_path.parent.parent):
         ini = folder / "seqinfo.ini"
         if ini.is_file():
             parser = configparser.ConfigParser()
             try:
-                parser.read(ini, encoding="utf-8")
-                return int(parser["Sequence"]["seqLength"])
+                parser.read_string(read_text(ini, _gt_error(ini), "seqinfo.ini"))
+                length = int(parser["Sequence"]["seqLength"])
             except (KeyError, ValueError, configparser.Error) as err:
-                raise GroundTruthError(ini, f"no integer [Sequence] seqLength ({err})") from err
+                message = " ".join(str(err).split())[:200]
+                raise GroundTruthError(ini, f"no integer [Sequence] seqLength ({message})") from err
+            if not 1 <= length <= MAX_TIMELINE_FRAMES:
+                raise GroundTruthError(
+                    ini, f"seqLength {length} outside 1..{MAX_TIMELINE_FRAMES} frames"
+                )
+            return length
     return None
 
 
-def read_mot_tracks(path: Path) -> TrackerOutput:
-    """MOTChallenge tracker output; world x, y, z from columns 8-10 where not -1."""
+def read_mot_tracks(path: Path, text: str | None = None) -> TrackerOutput:
+    """MOTChallenge tracker output (``text``: the file's, when already read); world x, y, z
+    from columns 8-10 where not -1."""
     path = Path(path)
-    rows = _mot_rows(path, InputError)
+    error = _tracks_error(path)
+    rows = _mot_rows(text if text is not None else read_text(path, error, "tracker output"), error)
     by_frame: dict[int, list[TrackOutput]] = {}
-    for row in rows:
+    for line, row in enumerate(rows, start=1):
         world = row.shape[0] >= 10 and not np.all(row[7:10] == -1)
         x, y, z = (float(v) for v in row[7:10]) if world else (math.nan,) * 3
         if row[4] < 0 or row[5] < 0:
             raise InputError(path, f"frame {int(row[0])} id {int(row[1])}: negative box size")
+        if world and (problem := position_problem((x, y, z))) is not None:
+            raise InputError(path, f"row {line}: {problem}")
         by_frame.setdefault(int(row[0]) - MOT_FIRST_FRAME, []).append(
             TrackOutput(
                 track_id=int(row[1]),
@@ -185,22 +227,53 @@ def read_mot_tracks(path: Path) -> TrackerOutput:
     return TrackerOutput(str(path), frames)
 
 
-def _mot_benchmark(rows: np.ndarray, benchmark: Benchmark) -> Benchmark:
-    if benchmark is not Benchmark.AUTO:
-        return benchmark
+#: MOTChallenge's class ids (MOT16/17/20 ground truth, column 8).
+_CLASSES = range(1, 13)
+
+
+def _has_classes(rows: np.ndarray) -> bool:
+    """Whether the rows have MOT16/17/20's layout: 9 columns, column 8 a class id."""
+    return (
+        bool(rows.size)
+        and rows.shape[1] == 9
+        and bool(np.isin(rows[:, 7], np.array(_CLASSES, dtype=np.float64)).all())
+    )
+
+
+def _mot_benchmark(rows: np.ndarray, benchmark: Benchmark, error: Err) -> Benchmark:
+    """The rules to apply; an error when the file's layout contradicts the chosen ones."""
     # MOT16/17/20 ground truth has 9 columns (class and visibility in 8 and 9); MOT15 has
     # 10 (world x, y, z in 8-10, -1 when unknown).
-    has_classes = bool(rows.size) and rows.shape[1] == 9 and bool((rows[:, 7] >= 1).all())
-    return Benchmark.MOT17 if has_classes else Benchmark.MOT15
+    if benchmark is Benchmark.AUTO:
+        return Benchmark.MOT17 if _has_classes(rows) else Benchmark.MOT15
+    if rows.size and benchmark is not Benchmark.MOT15:
+        if rows.shape[1] < 8:
+            raise error(f"{benchmark.value} ground truth needs the class column (8)")
+        classes = rows[:, 7]
+        bad = np.flatnonzero(~np.isin(classes, np.array(_CLASSES, dtype=np.float64)))
+        if bad.size:
+            k = int(bad[0])
+            raise error(
+                f"--benchmark {benchmark.value}: row {k + 1} has class {classes[k]:g} in "
+                f"column 8, not a MOTChallenge class 1..12 (MOT15 ground truth? use "
+                "--benchmark mot15 or auto)"
+            )
+    return benchmark
 
 
-def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTruth:
-    """MOTChallenge ground truth with the devkit's rules (see the module docstring)."""
+def read_mot_gt(
+    path: Path, benchmark: Benchmark = Benchmark.AUTO, text: str | None = None
+) -> GroundTruth:
+    """MOTChallenge ground truth with the devkit's rules (see the module docstring);
+    ``text``: the file's, when already read.
+
+    A GroundTruthError when the file does not have the chosen benchmark's layout, holds
+    a box of no size, or leaves nothing to score under its rules.
+    """
     path = Path(path)
-    rows = _mot_rows(path, GroundTruthError)
-    rules = _mot_benchmark(rows, benchmark)
-    if rules is not Benchmark.MOT15 and (rows.size and rows.shape[1] < 8):
-        raise GroundTruthError(path, f"{rules.value} ground truth needs the class column (8)")
+    error = _gt_error(path)
+    rows = _mot_rows(text if text is not None else read_text(path, error, "ground truth"), error)
+    rules = _mot_benchmark(rows, benchmark, error)
     objects = []
     for row in rows:
         frame, oid = int(row[0]) - MOT_FIRST_FRAME, int(row[1])
@@ -230,6 +303,15 @@ def read_mot_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> GroundTrut
                 distractor=distractor,
             )
         )
+    if objects and all(o.ignore for o in objects):
+        raise error(
+            f"no row is scored under {rules.value} rules (every row is ignored: "
+            + (
+                "consider flag 0)"
+                if rules is Benchmark.MOT15
+                else "not a pedestrian, class 1, with the consider flag set)"
+            )
+        )
     return from_objects(str(path), objects, first_frame=MOT_FIRST_FRAME)
 
 
@@ -244,50 +326,76 @@ def _float(text: str | None) -> float | None:
     return float(text)
 
 
-def read_tracks_csv(path: Path) -> TrackerOutput:
-    """Our ``tracks.csv``: frame, id, box, confidence, world x/y/z, stamp, height, visibility,
-    status."""
+def track_problem(track: TrackOutput) -> str | None:
+    """Why a track read from a file cannot be scored as given (None when it can): a box
+    that is not finite, negative or beyond image coordinates, a position beyond
+    :data:`~rgbd_eval.io.validate.MAX_POSITION_M` (NaN: no position)."""
+    if abs(track.track_id) >= MAX_ID:
+        return f"id {track.track_id} is not smaller than 2**53 in magnitude"
+    if track.box2d is not None:
+        values = track.box2d.as_tuple()
+        if not all(math.isfinite(v) for v in values):
+            return f"box {values} is not finite"
+        if values[2] < 0 or values[3] < 0:
+            return f"box size {values[2]}x{values[3]} is negative"
+        if any(abs(v) > MAX_PIXELS for v in values):
+            return f"box {values} lies beyond {MAX_PIXELS:g} pixels"
+    position = (track.x, track.y)
+    if not all(math.isnan(v) for v in position):
+        problem = position_problem(position)
+        if problem is not None:
+            return problem
+    if math.isinf(track.height):
+        return f"height {track.height} is not finite"
+    if track.confidence is not None and not math.isfinite(track.confidence):
+        return f"confidence {track.confidence} is not finite"
+    return None
+
+
+def read_tracks_csv(path: Path, text: str | None = None) -> TrackerOutput:
+    """Our ``tracks.csv``: frame, id, box, confidence, world x/y/z, stamp, height,
+    visibility, status (``text``: the file's, when already read)."""
     from rgbd_eval.types import TrackStatus
 
     path = Path(path)
-    try:
-        with path.open(encoding="utf-8", newline="") as handle:
-            reader = csv.DictReader(handle)
-            missing = [c for c in _TRACKS_CSV_REQUIRED if c not in (reader.fieldnames or [])]
-            if missing:
-                raise InputError(path, f"tracks CSV lacks the column(s) {missing}")
-            by_frame: dict[int, tuple[int, list[TrackOutput]]] = {}
-            for number, row in enumerate(reader, start=2):
-                if None in row:  # csv.DictReader files extra fields under the key None
-                    raise InputError(path, f"line {number}: more fields than the header")
-                if None in row.values():  # ... and fills missing ones with None
-                    raise InputError(path, f"line {number}: fewer fields than the header")
-                try:
-                    frame = int(row["frame"])
-                    box = [_float(row[k]) for k in _TRACKS_CSV_REQUIRED[2:6]]
-                    stamp = int(row.get("stamp_ns") or 0)
-                    z = _float(row.get("z"))
-                    height = _float(row.get("height"))
-                    track = TrackOutput(
-                        track_id=int(row["id"]),
-                        x=float(row["x"]),
-                        y=float(row["y"]),
-                        height=height
-                        if height is not None
-                        else (2 * z if z is not None else math.nan),
-                        box2d=None if any(v is None for v in box) else Box2D(*box),  # type: ignore[arg-type]
-                        visibility=Visibility[(row.get("visibility") or "visible").upper()],
-                        status=TrackStatus(row.get("status") or "validated"),
-                        confidence=_float(row.get("conf")),
-                    )
-                except (ValueError, KeyError) as err:
-                    raise InputError(path, f"line {number}: {err}") from err
-                entry = by_frame.setdefault(frame, (stamp, []))
-                if entry[0] != stamp:
-                    raise InputError(path, f"line {number}: frame {frame} has two stamps")
-                entry[1].append(track)
-    except OSError as err:
-        raise InputError(path, f"cannot read ({err.strerror})") from err
+    if text is None:
+        text = read_text(path, _tracks_error(path), "tracker output")
+    with io.StringIO(text, newline="") as handle:
+        reader = csv.DictReader(handle)
+        missing = [c for c in _TRACKS_CSV_REQUIRED if c not in (reader.fieldnames or [])]
+        if missing:
+            raise InputError(path, f"tracks CSV lacks the column(s) {missing}")
+        by_frame: dict[int, tuple[int, list[TrackOutput]]] = {}
+        for number, row in enumerate(reader, start=2):
+            if None in row:  # csv.DictReader files extra fields under the key None
+                raise InputError(path, f"line {number}: more fields than the header")
+            if None in row.values():  # ... and fills missing ones with None
+                raise InputError(path, f"line {number}: fewer fields than the header")
+            try:
+                frame = int(row["frame"])
+                box = [_float(row[k]) for k in _TRACKS_CSV_REQUIRED[2:6]]
+                stamp = int(row.get("stamp_ns") or 0)
+                z = _float(row.get("z"))
+                height = _float(row.get("height"))
+                track = TrackOutput(
+                    track_id=int(row["id"]),
+                    x=float(row["x"]),
+                    y=float(row["y"]),
+                    height=height if height is not None else (2 * z if z is not None else math.nan),
+                    box2d=None if any(v is None for v in box) else Box2D(*box),  # type: ignore[arg-type]
+                    visibility=Visibility[(row.get("visibility") or "visible").upper()],
+                    status=TrackStatus(row.get("status") or "validated"),
+                    confidence=_float(row.get("conf")),
+                )
+                problem = frame_problem(frame, stamp) or track_problem(track)
+                if problem is not None:
+                    raise ValueError(problem)
+            except (ValueError, KeyError) as err:
+                raise InputError(path, f"line {number}: {err}") from err
+            entry = by_frame.setdefault(frame, (stamp, []))
+            if entry[0] != stamp:
+                raise InputError(path, f"line {number}: frame {frame} has two stamps")
+            entry[1].append(track)
     frames = tuple(
         (f, s, tuple(t)) for f, (s, t) in sorted(by_frame.items(), key=lambda i: (i[1][0], i[0]))
     )
@@ -299,7 +407,7 @@ def read_ktp_tracks(path: Path) -> TrackerOutput:
     try:
         parsed = read_ktp(path)
     except GroundTruthError as err:
-        raise InputError(path, str(err).split(": ", 1)[-1]) from err
+        raise InputError(path, err.message) from err
     frames = tuple(
         (
             f,
@@ -317,6 +425,7 @@ def read_ktp_tracks(path: Path) -> TrackerOutput:
             ),
         )
         for f, s, objs in parsed.frames
+        if objs  # a line with no entry: no track in that frame
     )
     return TrackerOutput(str(path), frames)
 
@@ -344,27 +453,62 @@ def load_tracks(
         from rgbd_eval.io.track_messages import read_bag_tracks
 
         return read_bag_tracks(path, topic, world_frame)
-    check_input(path, lambda m: InputError(path, m), "tracker output")  # no pipe, no device
-    if is_mot_text(path):
-        return read_mot_tracks(path)
-    if "," in _first_data_line(path) and ":" not in _first_data_line(path):
-        return read_tracks_csv(path)
+    text = read_text(path, _tracks_error(path), "tracker output")  # no pipe, bounded, UTF-8
+    if _looks_like_mot(text):
+        return read_mot_tracks(path, text)
+    first = _first_data_line(text)
+    if "," in first and ":" not in first:
+        return read_tracks_csv(path, text)
     return read_ktp_tracks(path)
 
 
 def load_gt(path: Path, benchmark: Benchmark = Benchmark.AUTO) -> tuple[GroundTruth, int | None]:
-    """Ground truth for scoring and the sequence length where a ``seqinfo.ini`` states it."""
+    """Ground truth for scoring and the sequence length where a ``seqinfo.ini`` states it.
+
+    It must annotate somebody (an empty file is a GroundTruthError, not all false positives).
+    """
     path = Path(path)
-    check_input(path, lambda m: GroundTruthError(path, m), "ground truth")
-    if is_mot_text(path):
-        return read_mot_gt(path, benchmark), seq_length(path)
+    text = read_text(path, _gt_error(path), "ground truth")  # no pipe, bounded, UTF-8
+    if _looks_like_mot(text):
+        return require_objects(read_mot_gt(path, benchmark, text)), seq_length(path)
     return load_ground_truth(path), None
 
 
 # ----------------------------------------------------------------------------- alignment
 
 
+def _check_timeline(gt: GroundTruth, tracks: TrackerOutput, length: int | None) -> None:
+    """An error before a timeline of more than :data:`MAX_TIMELINE_FRAMES` frames is built,
+    or when a frame lies outside ``seqinfo.ini``'s ``1..length``; it names the input."""
+    for source, numbers, error in (
+        (gt.source, [f for f, _, _ in gt.frames], _gt_error),
+        (tracks.source, [f for f, _, _ in tracks.frames], _tracks_error),
+    ):
+        if not numbers:
+            continue
+        # frames are indices from 0 here; seqinfo.ini numbers them from MOT_FIRST_FRAME
+        if length is not None and not (min(numbers) >= 0 and max(numbers) < length):
+            outside = next(f for f in numbers if not 0 <= f < length) + MOT_FIRST_FRAME
+            raise error(Path(source))(
+                f"frame {outside} outside {MOT_FIRST_FRAME}..{length} (seqinfo.ini)"
+            )
+    if length is not None:
+        return
+    annotated = [f for f, _, _ in gt.frames]
+    both = annotated + [f for f, _, _ in tracks.frames]
+    for source, numbers, error in (
+        (gt.source, annotated, _gt_error),  # the ground truth's own span first
+        (tracks.source, both, _tracks_error),  # else the tracks reach too far from it
+    ):
+        if numbers and max(numbers) - min(numbers) + 1 > MAX_TIMELINE_FRAMES:
+            raise error(Path(source))(
+                f"frames {min(numbers)}..{max(numbers)} span more than the "
+                f"{MAX_TIMELINE_FRAMES} frames a sequence scored by frame number may have"
+            )
+
+
 def _by_frame_number(gt: GroundTruth, tracks: TrackerOutput, length: int | None) -> Aligned:
+    _check_timeline(gt, tracks, length)
     gt_frames = {f: list(objs) for f, _, objs in gt.frames}
     track_frames = {f: list(t) for f, _, t in tracks.frames}
     numbers = set(gt_frames) | set(track_frames)

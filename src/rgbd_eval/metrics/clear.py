@@ -31,7 +31,7 @@ first match is never an id switch, hence never a recall error.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -89,6 +89,16 @@ class SequenceScores:
     def summary(self) -> Summary:
         """The derived measures (:func:`rgbd_eval.metrics.counts.summarize`)."""
         return summarize(self.counts)
+
+    def placed(self, first: int, total: int) -> SequenceScores:
+        """These scores of frames ``first..`` of a ``total``-frame sequence, the frames before
+        and after given empty events (not scored): frame ``k`` here is ``first + k`` there.
+        The per-frame table stays that of the scored frames (its frame ``k`` is ``first + k``)."""
+        if first == 0 and len(self.frames) == total:
+            return self
+        scored = {first + e.frame: replace(e, frame=first + e.frame) for e in self.frames}
+        frames = tuple(scored.get(k) or FrameEvents(k, (), (), (), (), ()) for k in range(total))
+        return SequenceScores(self.counts, frames, self.table)
 
 
 def evaluate_sequence(

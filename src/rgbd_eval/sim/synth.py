@@ -160,6 +160,7 @@ def synthesize(
         raise ValueError(f"max_frames={max_frames} must be at least 1")
     start = time.perf_counter()
     truth: list[GroundTruthObject] = []
+    annotated: list[tuple[int, int]] = []  # every frame, people in view or not
     try:
         with RecordingWriter(out, kind, stream_options(scenario), owner=OWNER) as w:
             extra = [make_rig_sensor(c, rig.WORLD_FRAME) for c in scenario.rig]
@@ -170,11 +171,12 @@ def synthesize(
                 for k, sensor in enumerate(extra):
                     sensor.write(w, sim.scene_view(f.index, k))
                 truth.extend(f.ground_truth)
+                annotated.append((f.index, f.stamp_ns))
                 if progress is not None:
                     progress(f.index + 1, total)
     except OSError as err:  # a full disk: the writer removed its temporary file
         raise OutputError(out, f"cannot write ({err.strerror or err})") from err
-    write_csv(csv_path, truth, OWNER)
+    write_csv(csv_path, truth, annotated, OWNER)
     elapsed = time.perf_counter() - start
     return SynthResult(out, csv_path, total, len(truth), elapsed, out.stat().st_size)
 

@@ -41,10 +41,15 @@ class Basso2012TrackerConfig(ComponentConfig):
     depth_noise_coefficient: float = Field(
         0.001425,
         ge=0.0,
+        le=0.1,
         description="Kinect depth error sigma = k * d^2 (m), Figure 6.1; k from Khoshelham & Elberink 2012",
     )
-    weak_classifiers: int = Field(250, ge=1, description="Table 6.1 ~recovery/weak_classifiers")
-    selectors: int = Field(50, ge=1, description="Table 6.1 ~recovery/selectors")
+    # Each track's classifier holds a selectors x weak_classifiers matrix (8 bytes a cell):
+    # the bounds, ten times Table 6.1's values, keep it under 10 MB a track.
+    weak_classifiers: int = Field(
+        250, ge=1, le=2500, description="Table 6.1 ~recovery/weak_classifiers"
+    )
+    selectors: int = Field(50, ge=1, le=500, description="Table 6.1 ~recovery/selectors")
     min_prediction: float = Field(9.0, description="Table 6.1 ~recovery/min_prediction")
     min_confidence: float = Field(-0.5, description="Table 6.1 ~target/min_confidence")
     frames_before_old: int = Field(90, ge=0, description="Table 6.1 ~target/frames_before_old")

@@ -54,7 +54,7 @@ from typing import Literal
 import cv2
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from rgbd_eval.config import ComponentConfig
 from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
@@ -137,6 +137,15 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     reid_memory_frames: int = Field(150, ge=0, description="how long a lost person is remembered")
     alignment_depth_m: float = Field(3.0, gt=0.0, description="nominal depth of the affine map")
     seed: int = Field(0, ge=0)
+
+    @model_validator(mode="after")
+    def _check(self) -> Cielniak2010TrackerConfig:
+        for low, high in (("min_height_px", "max_height_px"), ("person_min_m", "person_max_m")):
+            if not getattr(self, low) < getattr(self, high):
+                raise ValueError(
+                    f"{low}={getattr(self, low)} must be below {high}={getattr(self, high)}"
+                )
+        return self
 
 
 @dataclass(frozen=True)

@@ -62,13 +62,16 @@ class DmtbsTrackerConfig(ComponentConfig):
 
     gate_m: float = Field(1.0, gt=0.0, description="largest prediction-detection distance (m)")
     min_split_age_s: float = Field(
-        1.0, ge=0.0, description="only tracks at least this old are split (seed 003, 3.3: 1 s)"
+        1.0,
+        ge=0.0,
+        le=3600.0,
+        description="only tracks at least this old are split (seed 003, 3.3: 1 s)",
     )
     split_near_m: float = Field(
         0.1, ge=0.0, description="a prediction this close (m) to a blob's cell falls on it"
     )
     measurement_sigma_m: float = Field(
-        0.1, gt=0.0, description="std of a blob centroid around the person's axis (m)"
+        0.1, gt=0.0, le=10.0, description="std of a blob centroid around the person's axis (m)"
     )
     acceleration_variance: float = Field(
         4.0, gt=0.0, description="white-acceleration variance of the CV model (m^2/s^4)"
@@ -78,7 +81,10 @@ class DmtbsTrackerConfig(ComponentConfig):
     )
     confirm_hits: int = Field(3, ge=1, description="measured frames that confirm a track")
     max_missed_s: float = Field(
-        1.0, ge=0.0, description="a confirmed track without measurement this long is dropped (s)"
+        1.0,
+        ge=0.0,
+        le=3600.0,
+        description="a confirmed track without measurement this long is dropped (s)",
     )
 
 

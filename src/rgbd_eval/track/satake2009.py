@@ -67,11 +67,15 @@ class Satake2009TrackerConfig(ComponentConfig):
 
     name: Literal["satake2009"] = "satake2009"
     sigma_w: float = Field(1.0, gt=0.0, le=20.0, description="acceleration noise (m/s^2)")
-    sigma_v: float = Field(0.15, gt=0.0, le=5.0, description="observation noise (m)")
+    sigma_v: float = Field(0.15, ge=0.001, le=5.0, description="observation noise (m)")
     velocity: Literal["ground", "seed"] = Field("ground", description="eq. (3) variant")
-    initial_speed_std: float = Field(1.0, gt=0.0, description="prior std of a new velocity")
+    initial_speed_std: float = Field(
+        1.0, gt=0.0, le=10.0, description="prior std of a new velocity (m/s)"
+    )
     gate_probability: float = Field(0.99, gt=0.0, lt=1.0, description="chi^2 gate, 3 dof")
-    max_missed_s: float = Field(1.0, ge=0.0, description="a track unseen this long is dropped")
+    max_missed_s: float = Field(
+        1.0, ge=0.0, le=3600.0, description="a track unseen this long is dropped"
+    )
     min_hits: int = Field(2, ge=1, description="matches before a track is output")
     coast_min_hits: int = Field(10, ge=1, description="matches before an unseen track is output")
     min_separation_m: float = Field(
