@@ -158,6 +158,7 @@ class EvaluationConfig(_Model):
     distance_bands: list[float] = Field(
         [2.0, 4.0, 6.0],
         min_length=1,
+        max_length=50,
         description="edges (m) of the bands of distance from the camera: 0-2, 2-4, 4-6, 6+",
     )
     driving_speed: float = Field(
@@ -167,7 +168,10 @@ class EvaluationConfig(_Model):
         0.2, gt=0.0, description="rad/s (about 11.5 deg/s) above which the robot counts as turning"
     )
     bootstrap_replicates: int = Field(
-        1000, ge=0, description="replicates of the block bootstrap behind each interval (0: none)"
+        1000,
+        ge=0,
+        le=100_000,
+        description="replicates of the block bootstrap behind each interval (0: none)",
     )
     bootstrap_seed: int = Field(33, ge=0, description="the seed of the block bootstrap")
 
