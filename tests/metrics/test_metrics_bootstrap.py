@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -74,6 +75,14 @@ def test_weights_resample_every_frame_count() -> None:
     # Circular blocks of 5 of 10 frames starting at 8 (frames 8, 9, 0, 1, 2: wrapped) and 0.
     starts = np.array([[8, 0]])
     assert boot._weights(10, 5, starts).tolist() == [[2, 2, 2, 1, 1, 0, 0, 0, 1, 1]]
+    # Against counting frame by frame: blocks that wrap, the last one cut to n frames.
+    for n, block in ((150, 19), (71, 6), (10, 3), (7, 7), (9, 1), (13, 4)):
+        starts = rng.integers(0, n, size=(30, -(-n // block)))
+        counted = np.zeros((30, n))
+        for r, row in enumerate(starts.tolist()):
+            frames = [(s + j) % n for s in row for j in range(block)][:n]
+            np.add.at(counted[r], frames, 1)
+        assert (boot._weights(n, block, starts) == counted).all(), (n, block)
 
 
 TUD = Path(pytest.importorskip("motmetrics").__file__).parent / "data"
@@ -111,11 +120,34 @@ def test_small_assignments_tried_in_full_equal_the_hungarian() -> None:
     rows = np.repeat(np.arange(3), 4)
     cols = np.tile(np.arange(4), 3)
     part = boot._AssignmentPart(np.arange(12), rows, cols)
-    assert part.choices is not None  # 4 * 3 * 2 = 24 assignments, tried at once
+    assert part.matchings is not None  # 4 * 3 * 2 = 24 assignments, tried at once
+    assert part.matchings.shape == (24, 12)
     counts = rng.integers(0, 30, size=(12, 200)).astype(float)
     tried = part.best(counts)
-    part.choices = None  # the Hungarian path
+    part.matchings = None  # the Hungarian path
     assert (part.best(counts) == tried).all()
+
+
+def test_sparse_parts_are_tried_in_full_and_equal_the_hungarian() -> None:
+    """A sparse part: its maximal matchings, far fewer than the assignments of its shape,
+    give the Hungarian's totals (zero counts included: a pair seen in no resampled frame)."""
+    rng = np.random.default_rng(5)
+    # Rows 0..5 to columns 0..9: a chain (r, r), (r, r + 1) and a few more edges.
+    edges = [(r, r) for r in range(6)] + [(r, r + 1) for r in range(6)] + [(0, 9), (5, 8)]
+    rows = np.array([r for r, _ in edges])
+    cols = np.array([c for _, c in edges])
+    part = boot._AssignmentPart(np.arange(len(edges)), rows, cols)
+    assert part.matchings is not None and len(part.matchings) < math.perm(10, 6)
+    # Each a matching (one edge per row and per column at most), none a subset of another.
+    for m in part.matchings.astype(bool):
+        assert len(set(rows[m])) == len(set(cols[m])) == m.sum()
+    counts = rng.integers(0, 4, size=(len(edges), 300)).astype(float)
+    tried = part.best(counts)
+    part.matchings = None
+    assert (part.best(counts) == tried).all()
+    # A dense part has too many: the Hungarian.
+    dense_rows, dense_cols = np.repeat(np.arange(8), 12), np.tile(np.arange(12), 8)
+    assert boot.maximal_matchings(dense_rows, dense_cols, 8) is None
 
 
 def test_the_frame_table_saves_and_loads() -> None:

@@ -37,7 +37,6 @@ outside its interval when 0 is not between the 2.5th and 97.5th percentiles.
 
 from __future__ import annotations
 
-import itertools
 import math
 import zlib
 from collections.abc import Iterator, Mapping, Sequence
@@ -58,8 +57,6 @@ DEFAULT_REPLICATES = 1000
 DEFAULT_SEED = 33
 #: The coverage of every interval.
 CONFIDENCE = 0.95
-#: Replicates drawn at once (a constant: the draws must not depend on the sequence's length).
-CHUNK = 50
 #: Frame weights summed at once at most (replicates x frames): small arrays stay in the
 #: allocator's heap (large fresh ones cost page faults, more than the arithmetic).
 GROUP_WEIGHTS = 1 << 16
@@ -161,13 +158,21 @@ def _draw_starts(num_frames: int, block: int, count: int, rng: np.random.Generat
 
 def _weights(num_frames: int, block: int, starts: IntArray) -> FloatArray:
     """Frame weights ``(replicates, frames)`` (integer-valued floats) of block starts: each
-    block's frames (wrapping at the end), the first ``num_frames`` of a replicate, counted."""
+    block's frames (wrapping at the end), the first ``num_frames`` of a replicate, counted.
+
+    A block adds 1 to its run of frames: +1 where it starts, -1 after it ends (a block
+    that wraps also +1 at frame 0), summed along the frames."""
     n, (count, k) = num_frames, starts.shape
-    frames = (starts[:, :, None] + np.arange(block)[None, None, :]).reshape(count, k * block)
-    frames = frames[:, :n] % n
-    frames += (np.arange(count, dtype=np.int64) * n)[:, None]
-    counts = np.bincount(frames.ravel(), minlength=count * n)
-    out: FloatArray = counts.reshape(count, n).astype(np.float64)
+    ends = starts + block
+    ends[:, -1] -= k * block - n  # the last block is cut to the first n frames
+    wraps = ends > n
+    width = n + 1
+    offsets = np.arange(count, dtype=np.int64) * width
+    up = np.concatenate([(starts + offsets[:, None]).ravel(), offsets[np.nonzero(wraps)[0]]])
+    down = (np.where(wraps, ends - n, ends) + offsets[:, None]).ravel()
+    size = count * width
+    steps = np.bincount(up, minlength=size) - np.bincount(down, minlength=size)
+    out: FloatArray = np.cumsum(steps.reshape(count, width)[:, :n], axis=1).astype(np.float64)
     return out
 
 
@@ -182,23 +187,17 @@ def weights(num_frames: int, block: int, count: int, rng: np.random.Generator) -
 def weight_chunks(
     num_frames: int, block: int, replicates: int, rng: np.random.Generator
 ) -> Iterator[FloatArray]:
-    """The replicates' weights, drawn :data:`CHUNK` replicates at a time (so the draws do
-    not depend on the grouping), in groups of at most :data:`GROUP_WEIGHTS` weights."""
+    """The replicates' weights, in groups of about :data:`GROUP_WEIGHTS` weights. The block
+    starts are drawn at once, in replicate order (a generator's integers come in the same
+    order whatever the size of the draws: the grouping does not change them)."""
     if num_frames == 0:
         yield np.zeros((replicates, 0))
         return
     block = max(1, min(block, num_frames))
-    per_group = max(1, GROUP_WEIGHTS // num_frames // CHUNK)
-    done = 0
-    while done < replicates:
-        starts = []
-        for _ in range(per_group):
-            if done == replicates:
-                break
-            count = min(CHUNK, replicates - done)
-            starts.append(_draw_starts(num_frames, block, count, rng))
-            done += count
-        yield _weights(num_frames, block, np.concatenate(starts, axis=0))
+    starts = _draw_starts(num_frames, block, replicates, rng)
+    per_group = max(1, GROUP_WEIGHTS // num_frames)
+    for done in range(0, replicates, per_group):
+        yield _weights(num_frames, block, starts[done : done + per_group])
 
 
 # ----------------------------------------------------------------------------- replicate sums
@@ -243,18 +242,73 @@ class Replicates:
         )
 
 
-#: Parts of IDF1's pair graph with at most this many assignments are solved by trying
-#: them all (at once for every replicate); larger ones by the Hungarian algorithm.
-EXHAUSTIVE = 720
+#: Parts of IDF1's pair graph with at most this many maximal matchings are solved by
+#: trying them all (at once for every replicate); larger ones by the Hungarian algorithm.
+EXHAUSTIVE = 512
+#: Rows (the smaller side) beyond which a part is not enumerated (the Hungarian instead).
+_EXHAUSTIVE_ROWS = 64
+
+
+def maximal_matchings(
+    rows: IntArray, cols: IntArray, num_rows: int, limit: int = EXHAUSTIVE
+) -> list[list[int]] | None:
+    """Every maximal matching of the bipartite graph of edges ``(rows[i], cols[i])``, as
+    lists of edge indices; None when there are more than ``limit`` (or the search would be
+    long). With non-negative edge weights a best assignment is one of them: a matching
+    that is not maximal can take one more edge without losing weight.
+
+    Row by row, each row takes a free column of its edges or none; a row left without
+    one needs each of its columns taken by a later row, else the branch is cut."""
+    if num_rows > _EXHAUSTIVE_ROWS:
+        return None
+    edges: list[list[tuple[int, int]]] = [[] for _ in range(num_rows)]
+    last: dict[int, int] = {}  # per column, the last row with an edge to it
+    for e, (r, c) in enumerate(zip(rows.tolist(), cols.tolist(), strict=True)):
+        edges[r].append((e, c))
+        last[c] = max(last.get(c, r), r)
+    found: list[list[int]] = []
+    chosen: list[int] = []
+    used: set[int] = set()
+    skipped: list[int] = []
+    budget = 4 * limit  # search steps: a dense part ends the search early
+
+    def search(r: int) -> bool:
+        nonlocal budget
+        budget -= 1
+        if budget < 0 or len(found) > limit:
+            return False
+        # A row left unmatched needs its free columns taken by a row from r on.
+        if any(c not in used and last[c] < r for k in skipped for _, c in edges[k]):
+            return True
+        if r == num_rows:
+            found.append(list(chosen))
+            return True
+        for e, c in edges[r]:
+            if c not in used:
+                used.add(c)
+                chosen.append(e)
+                ok = search(r + 1)
+                chosen.pop()
+                used.discard(c)
+                if not ok:
+                    return False
+        skipped.append(r)
+        ok = search(r + 1)
+        skipped.pop()
+        return ok
+
+    if not search(0) or len(found) > limit:
+        return None
+    return found
 
 
 class _AssignmentPart:
     """One connected part of IDF1's pair graph, as columns ``pairs`` of the pair counts.
 
-    A part with one ground-truth id or one track id is solved by its largest count, a small
-    one by trying every assignment of its rows (the smaller side) to distinct columns, the
-    others by a Hungarian assignment per replicate. Counts are non-negative, so a best
-    assignment gives every row of the smaller side a column.
+    A part with one ground-truth id or one track id is solved by its largest count, one
+    with few maximal matchings (:func:`maximal_matchings`) by trying them all, the others by
+    a Hungarian assignment per replicate. Counts are non-negative, so a best assignment is
+    a maximal matching. Sums of integer counts: exact whichever way they are added.
     """
 
     def __init__(self, pairs: IntArray, rows: IntArray, cols: IntArray) -> None:
@@ -265,9 +319,14 @@ class _AssignmentPart:
         if shape[0] > shape[1]:  # rows <= columns: the solver then returns rows 0, 1, ...
             rows, cols, shape = cols, rows, (shape[1], shape[0])
         self.rows, self.cols, self.shape = rows.ravel(), cols.ravel(), shape
-        self.choices: IntArray | None = None
-        if shape[0] > 1 and math.perm(shape[1], shape[0]) <= EXHAUSTIVE:
-            self.choices = np.array(list(itertools.permutations(range(shape[1]), shape[0])))
+        #: Per maximal matching, 1 for its edges ``(matchings, edges)``; None: the Hungarian.
+        self.matchings: FloatArray | None = None
+        if shape[0] > 1:
+            found = maximal_matchings(self.rows, self.cols, shape[0])
+            if found is not None:
+                self.matchings = np.zeros((len(found), len(pairs)))
+                for k, edges in enumerate(found):
+                    self.matchings[k, edges] = 1.0
 
     def best(self, counts: FloatArray) -> FloatArray:
         """The best assignment's total of every replicate (columns of ``counts``)."""
@@ -275,14 +334,13 @@ class _AssignmentPart:
         if self.shape[0] == 1:
             star: FloatArray = values.max(axis=0)
             return star
+        if self.matchings is not None:
+            exhaustive: FloatArray = (self.matchings @ values).max(axis=0)
+            return exhaustive
         count = values.shape[1]
         dense = np.zeros((count, *self.shape))
         dense[:, self.rows, self.cols] = values.T
         rows = np.arange(self.shape[0])
-        if self.choices is not None:
-            tried = dense[:, rows[None, :], self.choices].sum(axis=2)  # (replicates, choices)
-            exhaustive: FloatArray = tried.max(axis=1)
-            return exhaustive
         picked = np.stack([linear_sum_assignment(m, maximize=True)[1] for m in dense])
         out: FloatArray = dense[np.arange(count)[:, None], rows[None, :], picked].sum(axis=1)
         return out
