@@ -7,13 +7,28 @@ uniformly from the ``n`` frames, takes ``L`` frames from each (wrapping at the e
 keeps the first ``n``. A replicate is then a weight per frame (how often it was drawn),
 and every summable count of the replicate is the weighted sum of the per-frame
 contributions recorded by the scorer (:class:`~rgbd_eval.metrics.frames.FrameTable`).
-IDF1 and HOTA have a global step: per replicate, IDF1's id assignment is solved again on
-the weighted pair counts, and HOTA's association (its alignment of ids over the
-sequence) is recomputed from the weighted pair, ground-truth and track counts; HOTA's
-per-frame pairs are those of the full sequence. The ratios of a replicate come from its
+IDF1 and HOTA have a global step, solved again for every replicate: IDF1's id assignment
+on the replicate's weighted gate-pair counts (exactly: the Hungarian algorithm, or all
+maximal matchings of a sparse part, :class:`_AssignmentPart`), Main Tr.'s best track per
+person, and HOTA's association (its alignment of ids over the sequence) from the weighted
+pair, ground-truth and track counts. The ratios of a replicate come from its
 sums by :func:`replicate_metrics`, the formulas of
 :func:`rgbd_eval.metrics.counts.summarize`; the interval is the 2.5th and 97.5th
 percentile of the replicates (the order statistics, no interpolation).
+
+What a replicate takes from the full sequence (is conditioned on): each frame's CLEAR
+matching with its ID-switch and recall-error flags, and HOTA's per-frame pairs. Scoring
+the glued blocks anew would run the CLEAR matching across every seam between blocks,
+frames that are not consecutive: a switch would appear at each seam that the tracker
+never made, and a match kept from "the previous frame" would be one of another moment,
+artefacts of the resampling rather than of the tracker. Keeping what the tracker's real
+history gave each frame resamples the frames' contributions, whose correlation the
+blocks keep; this is the usual way to block-bootstrap a statistic with a sequential step.
+HOTA's per-frame pairs would move only where a frame is ambiguous (two candidates whose
+global association scores change with the replicate). Where every frame's matching is
+unambiguous, a replicate equals scoring its resampled frames anew exactly in every metric
+but ID switches, recall errors and MOTA (tested: ``test_replicates_equal_rescoring_the_
+resampled_frames``); those three count the full sequence's switches in the frames drawn.
 
 Block length ``L``: chosen per sequence from its series of errors per frame (FN + FP +
 ID switches, the numerator of MOTA) by the automatic rule of Politis & White (2004, with
@@ -43,6 +58,7 @@ from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
 from scipy import sparse
 from scipy.optimize import linear_sum_assignment
@@ -60,6 +76,9 @@ CONFIDENCE = 0.95
 #: Frame weights summed at once at most (replicates x frames): small arrays stay in the
 #: allocator's heap (large fresh ones cost page faults, more than the arithmetic).
 GROUP_WEIGHTS = 1 << 16
+#: The largest table of block counts (columns x 2 frames) prepared to sum replicates by
+#: their blocks (:meth:`_SequenceSums.chunk`); larger tables sum the frame weights.
+BLOCK_SUMS_MAX = 1 << 20
 
 #: The metrics that get an interval: those :func:`replicate_metrics` derives.
 INTERVAL_METRICS = (
@@ -184,20 +203,29 @@ def weights(num_frames: int, block: int, count: int, rng: np.random.Generator) -
     return _weights(num_frames, block, _draw_starts(num_frames, block, count, rng))
 
 
-def weight_chunks(
-    num_frames: int, block: int, replicates: int, rng: np.random.Generator
-) -> Iterator[FloatArray]:
-    """The replicates' weights, in groups of about :data:`GROUP_WEIGHTS` weights. The block
-    starts are drawn at once, in replicate order (a generator's integers come in the same
-    order whatever the size of the draws: the grouping does not change them)."""
-    if num_frames == 0:
-        yield np.zeros((replicates, 0))
-        return
-    block = max(1, min(block, num_frames))
+def start_chunks(
+    num_frames: int, block: int, replicates: int, rng: np.random.Generator, width: int
+) -> Iterator[IntArray]:
+    """The replicates' block starts ``(replicates, ceil(n / block))``, in groups of about
+    :data:`GROUP_WEIGHTS` values, ``width`` per replicate. They are drawn at once, in
+    replicate order (a generator's integers come in the same order whatever the size of
+    the draws: the grouping does not change them). ``0 < block <= num_frames``."""
     starts = _draw_starts(num_frames, block, replicates, rng)
-    per_group = max(1, GROUP_WEIGHTS // num_frames)
+    per_group = max(1, GROUP_WEIGHTS // max(width, 1))
     for done in range(0, replicates, per_group):
-        yield _weights(num_frames, block, starts[done : done + per_group])
+        yield starts[done : done + per_group]
+
+
+def _window_sums(values: FloatArray, lengths: Sequence[int]) -> FloatArray:
+    """``(len(lengths) * n, columns)``: for each length L, row ``s`` holds the sums of the
+    columns of ``values`` ``(columns, n)`` over frames ``s .. s + L - 1`` (wrapping).
+    Integer counts: prefix sums and their differences are exact."""
+    width, n = values.shape
+    prefix = np.zeros((width, 2 * n + 1))
+    np.cumsum(np.concatenate([values, values], axis=1), axis=1, out=prefix[:, 1:])
+    runs = [prefix[:, length : length + n] - prefix[:, :n] for length in lengths]
+    out: FloatArray = np.ascontiguousarray(np.concatenate(runs, axis=1).T)
+    return out
 
 
 # ----------------------------------------------------------------------------- replicate sums
@@ -432,10 +460,12 @@ class _SequenceSums:
         switches = design.add(t.match_frame[t.match_switch], 0, 1)
         recalls = design.add(t.match_frame[t.match_recall], 0, 1)
         self.flags = slice(switches.start, recalls.stop)
+        # The caller's series; those all zero (a band nobody is in) need no column.
         series = np.zeros((len(extra), t.num_frames), dtype=np.int64)
         for k, values in enumerate(extra.values()):
             series[k] = values
-        self.extra = design.add_series(series)
+        self.extra_columns = len(BASE_COLUMNS) + np.flatnonzero(series.any(axis=1))
+        self.extra = design.add_series(series[series.any(axis=1)])
         # Main Tr.: matches per (gt, track) pair; the best track per gt.
         keys = t.match_gt * num_tracks + t.match_track
         pairs, inverse = np.unique(keys, return_inverse=True)
@@ -446,34 +476,104 @@ class _SequenceSums:
         pairs, inverse = np.unique(keys, return_inverse=True)
         self.potential = design.add(t.potential_frame, inverse.ravel(), len(pairs))
         self.id_parts = _assignment_parts(pairs // num_tracks, pairs % num_tracks)
-        # HOTA: per pair its matches by level.
+        # HOTA: per pair its matches by level, a column for each (level, pair) that occurs.
         keys = t.hota_gt * num_tracks + t.hota_track
         pairs, inverse = np.unique(keys, return_inverse=True)
         self.num_hota_pairs = len(pairs)
-        column = t.hota_levels() * len(pairs) + inverse.ravel()
-        self.pair_levels = design.add(t.hota_frame, column, len(pairs) * (_N_ALPHA + 1))
+        levels = np.unique(t.hota_levels() * len(pairs) + inverse.ravel(), return_inverse=True)
+        self.pair_levels = design.add(t.hota_frame, levels[1].ravel(), len(levels[0]))
+        self.level_pair = levels[0] % max(len(pairs), 1)  # sorted by level, then pair
+        self.level_rows = np.searchsorted(levels[0] // max(len(pairs), 1), np.arange(_N_ALPHA + 2))
         self.hota_pair_gt = pairs // num_tracks
         self.hota_pair_track = pairs % num_tracks
         self.similarity = t.per_frame(t.match_frame, t.match_value).astype(np.float64)
         self.design = design.matrix()
+        self.num_frames = t.num_frames
+        self._block_counts: dict[tuple[int, int], FloatArray] = {}
+        self._block_similarity: dict[tuple[int, int], FloatArray] = {}
 
-    def chunk(self, w: FloatArray) -> tuple[FloatArray, ...]:
-        """The sums ``(replicate, ...)`` of the replicates whose frame weights are ``w``."""
-        count = len(w)
-        # Integer counts with integer weights: exact in any summation order.
-        sums = np.asarray(self.design @ w.T)  # (columns, replicates)
-        similarity = np.add.reduce(w * self.similarity[None, :], axis=1)
+    def _last(self, block: int, k: int) -> int:
+        """The length of a replicate's last block of ``k`` (cut to the first n frames)."""
+        return self.num_frames - (k - 1) * block
+
+    def _picks(self, starts: IntArray) -> tuple[IntArray, sparse.csr_matrix]:
+        """Per replicate the rows of its blocks in :meth:`_blocks`' tables (``start`` for a
+        full block, ``n + start`` for the last, cut one), and them as a sparse matrix
+        ``(replicates, 2 n)``."""
+        count, k = starts.shape
+        rows = starts.copy()
+        rows[:, -1] += self.num_frames
+        picks = sparse.csr_matrix(
+            (np.ones(count * k), rows.ravel(), np.arange(0, count * k + 1, k)),
+            shape=(count, 2 * self.num_frames),
+        )
+        return rows, picks
+
+    def by_blocks(self) -> bool:
+        """Whether replicates are summed over their blocks (each block's counts, prepared
+        once: the table of :meth:`_blocks` fits :data:`BLOCK_SUMS_MAX`), else over the frame
+        weights (every event of the table times each replicate's weights). Measured on the
+        TUD sequences and the demo, blocks of 1 to 40 frames, the blocks are never slower."""
+        return bool(self.design.shape[0] * 2 * self.num_frames <= BLOCK_SUMS_MAX)
+
+    def width(self, by_blocks: bool) -> int:
+        """The values held per replicate while it is summed (:func:`start_chunks`)."""
+        return int(self.design.shape[0]) + (0 if by_blocks else self.num_frames)
+
+    def _blocks(self, block: int, k: int, by_blocks: bool | None) -> FloatArray | None:
+        """The counts of the run of ``block`` frames from each frame, and of the last block's
+        run ``(2 n, columns)`` (:func:`_window_sums`), when summing those is the cheaper way
+        (``by_blocks`` None; True or False: that way); None: by frame weights."""
+        if by_blocks is None:
+            by_blocks = self.by_blocks()
+        if not by_blocks:
+            return None
+        key = (block, k)
+        if key not in self._block_counts:
+            lengths = (block, self._last(block, k))
+            self._block_counts[key] = _window_sums(self.design.toarray(), lengths)
+        return self._block_counts[key]
+
+    def _similarities(self, block: int, k: int) -> FloatArray:
+        """The MOTP similarity summed over each run, as :meth:`_blocks` (``(2 n,)``), each
+        sum in numpy's fixed order."""
+        key = (block, k)
+        if key not in self._block_similarity:
+            twice = np.concatenate([self.similarity, self.similarity])
+            n = self.num_frames
+            runs = [
+                np.add.reduce(sliding_window_view(twice, length)[:n], axis=1)
+                for length in (block, self._last(block, k))
+            ]
+            self._block_similarity[key] = np.concatenate(runs)
+        return self._block_similarity[key]
+
+    def chunk(
+        self, starts: IntArray, block: int, by_blocks: bool | None = None
+    ) -> tuple[FloatArray, ...]:
+        """The sums ``(replicate, ...)`` of the replicates whose block starts are ``starts``
+        (:func:`_weights`). The counts are summed over the frame weights (the table's events
+        times each replicate's weights) or over the blocks (each block's counts, prepared
+        once per start), whichever is cheaper (``by_blocks``: that way): integer sums, the
+        same either way. The similarity behind MOTP is summed over the blocks."""
+        count, k = starts.shape
+        rows, picks = self._picks(starts)
+        blocks = self._blocks(block, k, by_blocks)
+        if blocks is None:
+            # Integer counts with integer weights: exact in any summation order.
+            w = _weights(self.num_frames, block, starts)
+            sums = np.asarray(self.design @ w.T)  # (columns, replicates)
+        else:
+            sums = np.ascontiguousarray(np.asarray(picks @ blocks).T)
+        similarity = np.add.reduce(self._similarities(block, k)[rows], axis=1)
         gt_count, track_count = sums[self.gt_count], sums[self.track_count]
         main = sums[self.main]
-        by_level = sums[self.pair_levels].reshape(_N_ALPHA + 1, self.num_hota_pairs, count)
         ints = np.zeros((len(self.columns), count))
         ints[0] = gt_count.sum(axis=0)
         ints[1] = track_count.sum(axis=0)
         ints[2] = main.sum(axis=0)
         ints[3:5] = sums[self.flags]
-        # HOTA's TP at threshold a: the pairs of level > a.
-        ints[5 : 5 + _N_ALPHA] = np.cumsum(by_level.sum(axis=1)[:0:-1], axis=0)[::-1]
-        ints[5 + _N_ALPHA :] = sums[self.extra]
+        ints[self.extra_columns] = sums[self.extra]
         main_tr = np.zeros(count)
         if len(main):
             main_tr = np.maximum.reduceat(main, self.main_gt_starts, axis=0).sum(axis=0)
@@ -481,22 +581,31 @@ class _SequenceSums:
         idtp = np.zeros(count)
         for part in self.id_parts:
             idtp += part.best(potential)
-        ass = self._hota_ass(by_level, gt_count, track_count)
+        ass = self._hota(sums[self.pair_levels], gt_count, track_count, ints[5 : 5 + _N_ALPHA])
         return ints.T, similarity, main_tr, idtp, ass.T
 
-    def _hota_ass(
-        self, by_level: FloatArray, gt_count: FloatArray, track_count: FloatArray
+    def _hota(
+        self, levels: FloatArray, gt_count: FloatArray, track_count: FloatArray, tp: FloatArray
     ) -> FloatArray:
-        count = by_level.shape[2]
+        """HOTA's association sums ``(19, replicates)``; ``tp`` gets the TP at each threshold
+        (the matches of a level above it). ``levels``: the (level, pair) columns' sums."""
+        count = levels.shape[1]
         ass = np.zeros((_N_ALPHA, count))
         if not self.num_hota_pairs:
             return ass
         both = gt_count[self.hota_pair_gt] + track_count[self.hota_pair_track]
         reach = np.zeros((self.num_hota_pairs, count))
+        total = np.zeros(count)
         # One threshold at a time, from the highest: small arrays, no large temporaries.
         for a in range(_N_ALPHA - 1, -1, -1):
-            reach += by_level[a + 1]  # the matches of level > a
-            ass[a] = np.add.reduce(reach * reach / np.maximum(1.0, both - reach), axis=0)
+            lo, hi = self.level_rows[a + 1], self.level_rows[a + 2]
+            if hi > lo or a == _N_ALPHA - 1:  # else the same pairs reach a as a + 1
+                reach[self.level_pair[lo:hi]] += levels[lo:hi]  # the matches of level a + 1
+                total += levels[lo:hi].sum(axis=0)
+                ass[a] = np.add.reduce(reach * reach / np.maximum(1.0, both - reach), axis=0)
+            else:
+                ass[a] = ass[a + 1]
+            tp[a] = total
         return ass
 
 
@@ -514,10 +623,11 @@ def replicates(
     """
     sums = _SequenceSums(table, extra or {})
     length = block_length(frame_errors(table)) if block is None else block
-    parts = [
-        sums.chunk(w)
-        for w in weight_chunks(table.num_frames, length, count, sequence_rng(seed, name))
-    ]
+    n, used = table.num_frames, max(1, min(length, table.num_frames))
+    by_blocks = sums.by_blocks()
+    rng = sequence_rng(seed, name)
+    draws = start_chunks(n, used, count, rng, sums.width(by_blocks)) if n else iter(())
+    parts = [sums.chunk(starts, used, by_blocks) for starts in draws]
     return _assemble(sums.columns, parts, count, (length,))
 
 
@@ -535,9 +645,13 @@ def paired_replicates(
         )
     first, second = _SequenceSums(tables[0], {}), _SequenceSums(tables[1], {})
     parts_a, parts_b = [], []
-    for w in weight_chunks(tables[0].num_frames, block, count, sequence_rng(seed, name)):
-        parts_a.append(first.chunk(w))
-        parts_b.append(second.chunk(w))
+    n, used = tables[0].num_frames, max(1, min(block, tables[0].num_frames))
+    ways = (first.by_blocks(), second.by_blocks())
+    width = max(first.width(ways[0]), second.width(ways[1]))
+    rng = sequence_rng(seed, name)
+    for starts in start_chunks(n, used, count, rng, width) if n else iter(()):
+        parts_a.append(first.chunk(starts, used, ways[0]))
+        parts_b.append(second.chunk(starts, used, ways[1]))
     return (
         _assemble(first.columns, parts_a, count, (block,)),
         _assemble(second.columns, parts_b, count, (block,)),
