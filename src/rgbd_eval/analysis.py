@@ -159,18 +159,26 @@ class Analysis:
 def _band_intervals(
     replicates: boot.Replicates | None, breakdowns: Sequence[bd.Breakdown]
 ) -> dict[tuple[str, str], dict[str, Interval]]:
-    """The intervals of every band that has ground truth, all sorted at once."""
-    if replicates is None:
+    """The intervals of every band that has ground truth, all bands at once."""
+    bands = [
+        (b.kind, band.label, b.with_fp)
+        for b in breakdowns
+        if b.available
+        for band in b.bands
+        if band.counts.num_gt > 0
+    ]
+    if replicates is None or not bands:
         return {}
-    values: dict[str, Any] = {}
-    for b in breakdowns:
-        if not b.available:
-            continue
-        for band in b.bands:
-            if band.counts.num_gt == 0:
-                continue
-            metrics = bd.band_replicate_metrics(replicates.column, b.kind, band.label, b.with_fp)
-            values.update({f"{b.kind}/{band.label}/{k}": v for k, v in metrics.items()})
+    metrics = bd.band_replicate_metrics(
+        lambda field: replicates.sums([f"{kind}/{label}/{field}" for kind, label, _ in bands]),
+        np.array([with_fp for _, _, with_fp in bands]),
+    )
+    values = {
+        f"{kind}/{label}/{name}": series[:, j]
+        for j, (kind, label, with_fp) in enumerate(bands)
+        for name, series in metrics.items()
+        if with_fp or name != "fp_rate"
+    }
     out: dict[tuple[str, str], dict[str, Interval]] = {}
     for key, interval in boot.intervals_of(values).items():
         kind, label, metric = key.split("/")

@@ -251,10 +251,16 @@ class Replicates:
 
     def column(self, name: str) -> FloatArray:
         """The replicates' sums of one frame-level column."""
-        index = self._index.get(name)
-        if index is None:
-            index = self._index.setdefault(name, self.columns.index(name))
-        return self.ints[:, index]
+        return self.ints[:, self._position(name)]
+
+    def sums(self, names: Sequence[str]) -> FloatArray:
+        """The replicates' sums of several frame-level columns ``(B, len(names))``."""
+        return self.ints[:, [self._position(name) for name in names]]
+
+    def _position(self, name: str) -> int:
+        if not self._index:
+            self._index.update((c, k) for k, c in enumerate(self.columns))
+        return self._index[name]
 
     def __add__(self, other: Replicates) -> Replicates:
         if self.columns != other.columns or len(self.ints) != len(other.ints):
@@ -596,13 +602,17 @@ class _SequenceSums:
         both = gt_count[self.hota_pair_gt] + track_count[self.hota_pair_track]
         reach = np.zeros((self.num_hota_pairs, count))
         total = np.zeros(count)
+        num, den = np.empty_like(reach), np.empty_like(reach)
         # One threshold at a time, from the highest: small arrays, no large temporaries.
         for a in range(_N_ALPHA - 1, -1, -1):
             lo, hi = self.level_rows[a + 1], self.level_rows[a + 2]
             if hi > lo or a == _N_ALPHA - 1:  # else the same pairs reach a as a + 1
                 reach[self.level_pair[lo:hi]] += levels[lo:hi]  # the matches of level a + 1
                 total += levels[lo:hi].sum(axis=0)
-                ass[a] = np.add.reduce(reach * reach / np.maximum(1.0, both - reach), axis=0)
+                # reach^2 / max(1, both - reach), summed over the pairs (in place: no allocations)
+                np.maximum(np.subtract(both, reach, out=den), 1.0, out=den)
+                np.divide(np.multiply(reach, reach, out=num), den, out=num)
+                np.add.reduce(num, axis=0, out=ass[a])
             else:
                 ass[a] = ass[a + 1]
             tp[a] = total
@@ -697,7 +707,7 @@ def replicate_metrics(r: Replicates) -> dict[str, FloatArray]:
     gt, tracks = r.column("num_gt"), r.column("num_tracks")
     matches, switches = r.column("num_matches"), r.column("id_switches")
     fn, fp = gt - matches, tracks - matches
-    tp = r.ints[:, [r.columns.index(f"hota_tp_{a}") for a in range(_N_ALPHA)]]
+    tp = r.sums([f"hota_tp_{a}" for a in range(_N_ALPHA)])
     det = tp / np.maximum(1.0, gt[:, None] + tracks[:, None] - tp)
     ass = r.hota_ass / np.maximum(1.0, tp)
     scored = (gt + tracks) > 0
@@ -718,6 +728,12 @@ def replicate_metrics(r: Replicates) -> dict[str, FloatArray]:
     }
 
 
+def _ends(n: int) -> tuple[int, int]:
+    """The ranks (1-based) of an interval's ends among ``n`` sorted values."""
+    tail = (1.0 - CONFIDENCE) / 2.0
+    return max(1, math.ceil(round(tail * n, 9))), max(1, math.ceil(round((1.0 - tail) * n, 9)))
+
+
 def interval(values: FloatArray) -> tuple[float, float] | None:
     """The :data:`CONFIDENCE` percentile interval of replicate values (None if all are NaN).
 
@@ -728,27 +744,31 @@ def interval(values: FloatArray) -> tuple[float, float] | None:
     n = len(finite)
     if not n:
         return None
-    tail = (1.0 - CONFIDENCE) / 2.0
-    lo = max(1, math.ceil(round(tail * n, 9)))
-    hi = max(1, math.ceil(round((1.0 - tail) * n, 9)))
+    lo, hi = _ends(n)
     return float(finite[lo - 1]), float(finite[hi - 1])
 
 
 def intervals_of(values: Mapping[str, FloatArray]) -> dict[str, tuple[float, float] | None]:
-    """:func:`interval` of each series, sorted all at once."""
+    """:func:`interval` of each series, all at once: the series without NaN partitioned
+    around the two ranks (the values a sort puts there, without sorting), the others sorted."""
     if not values:
         return {}
     names = list(values)
-    ordered = np.sort(np.stack([values[k] for k in names]), axis=1)  # NaN last
-    finite = (~np.isnan(ordered)).sum(axis=1)
-    tail = (1.0 - CONFIDENCE) / 2.0
+    series = np.stack([values[k] for k in names])
+    finite = (~np.isnan(series)).sum(axis=1)
+    full = finite == series.shape[1]
+    ordered = np.empty_like(series)
+    if full.any() and series.shape[1]:
+        lo, hi = _ends(series.shape[1])
+        ordered[full] = np.partition(series[full], (lo - 1, hi - 1), axis=1)
+    if not full.all():
+        ordered[~full] = np.sort(series[~full], axis=1)  # NaN last
     out: dict[str, tuple[float, float] | None] = {}
     for name, row, n in zip(names, ordered, finite.tolist(), strict=True):
         if not n:
             out[name] = None
             continue
-        lo = max(1, math.ceil(round(tail * n, 9)))
-        hi = max(1, math.ceil(round((1.0 - tail) * n, 9)))
+        lo, hi = _ends(n)
         out[name] = (float(row[lo - 1]), float(row[hi - 1]))
     return out
 

@@ -52,13 +52,14 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, field, fields
+from dataclasses import dataclass, field, fields, replace
+from operator import attrgetter
 
 import numpy as np
 
 from rgbd_eval import exact
 from rgbd_eval.config import Convention, EvaluationConfig
-from rgbd_eval.metrics.frames import FloatArray, FrameTable, IntArray
+from rgbd_eval.metrics.frames import BoolArray, FloatArray, FrameTable, IntArray, frames_of
 from rgbd_eval.metrics.selection import is_scored_track
 from rgbd_eval.types import GroundTruthObject, Pose, TrackOutput
 
@@ -251,6 +252,12 @@ def _sum(values: FloatArray) -> float:
 
 def motion_states(path: CameraPath, settings: Settings) -> list[str | None]:
     """Each frame's state (:data:`MOTION_STATES`), or None where it cannot be measured."""
+    return [None if k < 0 else MOTION_STATES[k] for k in _motion_codes(path, settings).tolist()]
+
+
+def _motion_codes(path: CameraPath, settings: Settings) -> IntArray:
+    """Each frame's state as its index in :data:`MOTION_STATES` (-1: cannot be measured):
+    turning above the turn rate, else driving above the speed, else standing."""
     stamps = np.array(path.stamps_ns, dtype=np.int64)
     window = int(MOTION_WINDOW_S * 1e9)
     j0 = np.searchsorted(stamps, stamps - window, side="left")
@@ -263,17 +270,13 @@ def motion_states(path: CameraPath, settings: Settings) -> list[str | None]:
         speed = np.sqrt(d[:, 0] * d[:, 0] + d[:, 1] * d[:, 1]) / dt
         rate = np.abs(turn) / dt
     known = (j1 > j0) & (dt > 0) & np.isfinite(speed) & np.isfinite(rate)
-    out: list[str | None] = []
-    for ok, v, r in zip(known.tolist(), speed.tolist(), rate.tolist(), strict=True):
-        if not ok:
-            out.append(None)
-        elif r > settings.turning_rate:
-            out.append("turning")
-        elif v > settings.driving_speed:
-            out.append("driving")
-        else:
-            out.append("standing")
-    return out
+    standing, turning, driving = (
+        MOTION_STATES.index(s) for s in ("standing", "turning", "driving")
+    )
+    driven = np.where(speed > settings.driving_speed, driving, standing)
+    state = np.where(rate > settings.turning_rate, turning, driven)
+    codes: IntArray = np.where(known, state, -1).astype(np.int64)
+    return codes
 
 
 # ----------------------------------------------------------------------------- instances
@@ -296,23 +299,22 @@ def instances(
     table: FrameTable,
     gt_frames: Sequence[Sequence[GroundTruthObject]],
     track_frames: Sequence[Sequence[TrackOutput]],
+    positions: bool = True,
 ) -> Instances:
-    """Look up the attributes of the table's instances in the frames they were scored from."""
+    """Look up the attributes of the table's instances in the frames they were scored from;
+    the positions (``gt_xy``, ``fp_xy``, for the distance bands) only when ``positions``,
+    else NaN."""
     t = table
-    objects = [(f, o) for f, frame in enumerate(gt_frames) for o in frame]
+    objects = list(itertools.chain.from_iterable(gt_frames))
     rows = _lookup(
         t.gt_ids,
-        [f for f, _ in objects],
-        [o.object_id for _, o in objects],
+        frames_of(gt_frames),
+        np.fromiter(map(attrgetter("object_id"), objects), dtype=np.int64, count=len(objects)),
         t.gt_frame,
         t.gt_index,
     )
-    picked = [objects[r][1] for r in rows.tolist()]
-    vis = np.array([o.visibility for o in picked], dtype=np.float64)
-    gxy = np.array(
-        [o.world_xyz[:2] if o.world_xyz is not None else (np.nan, np.nan) for o in picked],
-        dtype=np.float64,
-    ).reshape(-1, 2)
+    picked = list(map(objects.__getitem__, rows.tolist()))
+    vis = np.fromiter(map(attrgetter("visibility"), picked), dtype=np.float64, count=len(picked))
     # Matches -> their ground-truth instance (frame, gt).
     g = max(t.num_gt_tracks, 1)
     instance_keys = t.gt_frame * g + t.gt_index
@@ -323,24 +325,39 @@ def instances(
     k = max(t.num_tracks, 1)
     matched = np.isin(t.track_frame * k + t.track_index, t.match_frame * k + t.match_track)
     fp_frame = t.track_frame[~matched]
-    scored = [(f, o) for f, frame in enumerate(track_frames) for o in frame if is_scored_track(o)]
-    rows = _lookup(
-        t.track_ids,
-        [f for f, _ in scored],
-        [o.track_id for _, o in scored],
-        fp_frame,
-        t.track_index[~matched],
+    if not positions:
+        nan = np.full((len(picked) + len(fp_frame), 2), np.nan)
+        return Instances(vis, nan[: len(picked)], fp_frame, nan[len(picked) :], match_instance)
+    unknown = (np.nan, np.nan)
+    gxy = np.fromiter(
+        itertools.chain.from_iterable(
+            unknown if o.world_xyz is None else o.world_xyz[:2] for o in picked
+        ),
+        dtype=np.float64,
+        count=2 * len(picked),
+    ).reshape(-1, 2)
+    # Only the false positives' tracks are looked at (few, in their frames).
+    fp_ids = t.track_ids[t.track_index[~matched]].tolist()
+    fxy = np.array(
+        [_track_xy(track_frames[f], i) for f, i in zip(fp_frame.tolist(), fp_ids, strict=True)],
+        dtype=np.float64,
     )
-    fxy = np.array([(scored[r][1].x, scored[r][1].y) for r in rows.tolist()], dtype=np.float64)
     fxy = fxy.reshape(-1, 2)
     fxy[~np.isfinite(fxy).all(axis=1)] = np.nan
     return Instances(vis, gxy, fp_frame, fxy, match_instance)
 
 
+def _track_xy(tracks: Sequence[TrackOutput], track_id: int) -> tuple[float, float]:
+    """The position of the scored track ``track_id`` among one frame's tracks (it is there:
+    the table was scored from these frames)."""
+    track = next(o for o in tracks if o.track_id == track_id and is_scored_track(o))
+    return track.x, track.y
+
+
 def _lookup(
     ids: IntArray,
-    frames: Sequence[int],
-    object_ids: Sequence[int],
+    frames: IntArray,
+    object_ids: IntArray,
     query_frames: IntArray,
     query_index: IntArray,
 ) -> IntArray:
@@ -369,28 +386,35 @@ def _bands(
 ) -> Breakdown:
     """Counts per band from each instance's band (-1: none)."""
     t = table
-    n = t.num_frames
+    n, size = t.num_frames, len(labels) * t.num_frames
     match_band = gt_band[inst.match_instance]
+
+    def per_band(band: IntArray, frames: IntArray) -> IntArray:
+        """How many rows each band holds in each frame ``(bands, frames)``."""
+        kept = band >= 0
+        counts: IntArray = np.bincount(band[kept] * n + frames[kept], minlength=size)
+        return counts.reshape(len(labels), n)
+
+    series = np.zeros((len(labels), 4, n), dtype=np.int64)
+    series[:, 0] = per_band(gt_band, t.gt_frame)
+    series[:, 1] = per_band(match_band, t.match_frame)
+    if fp_band is not None:
+        series[:, 2] = per_band(fp_band, inst.fp_frame)
+    series[:, 3] = per_band(match_band[t.match_switch], t.match_frame[t.match_switch])
+    frames = ((series[:, 0] > 0) | (series[:, 2] > 0)).sum(axis=1).tolist()
+    totals = series.sum(axis=2).tolist()
     bands = []
     for b, label in enumerate(labels):
-        gt_rows = gt_band == b
-        m_rows = match_band == b
-        series = np.zeros((4, n), dtype=np.int64)
-        series[0] = np.bincount(t.gt_frame[gt_rows], minlength=n)
-        series[1] = np.bincount(t.match_frame[m_rows], minlength=n)
-        if fp_band is not None:
-            series[2] = np.bincount(inst.fp_frame[fp_band == b], minlength=n)
-        series[3] = np.bincount(t.match_frame[m_rows & t.match_switch], minlength=n)
-        present = (series[0] > 0) | (series[2] > 0)
+        num_gt, num_matches, fp, id_switches = totals[b]
         counts = BandCounts(
-            frames=int(present.sum()),
-            num_gt=int(series[0].sum()),
-            num_matches=int(series[1].sum()),
-            fp=int(series[2].sum()),
-            id_switches=int(series[3].sum()),
-            similarity_sum=float(np.add.reduce(t.match_value[m_rows])),
+            frames=frames[b],
+            num_gt=num_gt,
+            num_matches=num_matches,
+            fp=fp,
+            id_switches=id_switches,
+            similarity_sum=float(np.add.reduce(t.match_value[match_band == b])),
         )
-        bands.append(Band(label, counts, series))
+        bands.append(Band(label, counts, series[b]))
     return Breakdown(
         kind,
         tuple(bands),
@@ -447,29 +471,21 @@ def motion_breakdown(
         return not_available(MOTION, "no camera pose per frame")
     if not camera.odometry:
         return not_available(MOTION, "the recording has no odometry")
-    states = motion_states(camera, settings)
-    if all(s is None for s in states):
+    frame_band = _motion_codes(camera, settings)
+    if (frame_band < 0).all():
         return not_available(MOTION, "the camera's motion cannot be measured (no stamps)")
-    frame_band = np.array(
-        [-1 if s is None else MOTION_STATES.index(s) for s in states], dtype=np.int64
-    )
     gt_band = frame_band[table.gt_frame]
     fp_band = frame_band[inst.fp_frame]
     out = _bands(MOTION, MOTION_STATES, table, inst, gt_band, fp_band, True)
     # A band of frames: its frames are the frames in that state.
+    in_state = np.bincount(frame_band + 1, minlength=len(MOTION_STATES) + 1)[1:].tolist()
     bands = tuple(
-        Band(b.label, _with_frames(b.counts, int((frame_band == k).sum())), b.series)
-        for k, b in enumerate(out.bands)
+        Band(b.label, replace(b.counts, frames=frames), b.series)
+        for frames, b in zip(in_state, out.bands, strict=True)
     )
     return Breakdown(
         MOTION, bands, True, unassigned_gt=out.unassigned_gt, unassigned_fp=out.unassigned_fp
     )
-
-
-def _with_frames(counts: BandCounts, frames: int) -> BandCounts:
-    values = asdict(counts)
-    values["frames"] = frames
-    return BandCounts(**values)
 
 
 # ----------------------------------------------------------------------------- persons, gaps
@@ -535,8 +551,6 @@ def persons_and_gaps(
     stepped = np.flatnonzero(
         (t.per_frame(t.gt_frame) > 0) & (t.per_frame(t.track_frame) > 0)
     ).astype(np.int64)
-    gap_gaps = np.zeros(len(GAP_EDGES), dtype=np.int64)
-    gap_recovered = np.zeros(len(GAP_EDGES), dtype=np.int64)
     m_order = np.lexsort((t.match_frame, t.match_gt))
     m_gt, m_frame = t.match_gt[m_order], t.match_frame[m_order]
     m_track, m_switch = t.match_track[m_order], t.match_switch[m_order]
@@ -565,13 +579,6 @@ def persons_and_gaps(
                     gap - seen,
                 )
             )
-        # Gaps between consecutive matches.
-        lengths = np.diff(frames) - 1
-        gapped = lengths > 0
-        recovered = tracks[1:] == tracks[:-1]
-        bins = np.searchsorted(np.array(GAP_EDGES), lengths[gapped], side="right") - 1
-        np.add.at(gap_gaps, bins, 1)
-        np.add.at(gap_recovered, bins, recovered[gapped].astype(np.int64))
         persons.append(
             Person(
                 gt_id=int(t.gt_ids[g]),
@@ -583,9 +590,16 @@ def persons_and_gaps(
                 switches=tuple(switches),
             )
         )
+    # Gaps between consecutive matches of a person (of all persons at once), by length.
     labels = gap_labels()
+    lengths = np.diff(m_frame) - 1
+    gapped = (m_gt[1:] == m_gt[:-1]) & (lengths > 0)
+    bins = np.searchsorted(np.array(GAP_EDGES), lengths[gapped], side="right") - 1
+    back = (m_track[1:] == m_track[:-1])[gapped]  # recovered: the same track after the gap
+    gaps = np.bincount(bins, minlength=len(labels)).tolist()
+    recovered_gaps = np.bincount(bins[back], minlength=len(labels)).tolist()
     return tuple(persons), tuple(
-        GapBin(labels[k], int(gap_gaps[k]), int(gap_recovered[k])) for k in range(len(labels))
+        GapBin(label, gaps[k], recovered_gaps[k]) for k, label in enumerate(labels)
     )
 
 
@@ -632,7 +646,7 @@ def breakdowns(
     convention: Convention,
 ) -> SequenceBreakdowns:
     """The breakdowns of one scored sequence (``gt_frames``/``track_frames`` as scored)."""
-    inst = instances(table, gt_frames, track_frames)
+    inst = instances(table, gt_frames, track_frames, positions=camera is not None)
     persons, gaps = persons_and_gaps(table, convention)
     return SequenceBreakdowns(
         distance_breakdown(table, inst, camera, settings),
@@ -654,21 +668,22 @@ def band_series(b: SequenceBreakdowns) -> dict[str, IntArray]:
 
 
 def band_replicate_metrics(
-    column: Callable[[str], FloatArray], kind: str, label: str, with_fp: bool
+    sums: Callable[[str], FloatArray], with_fp: BoolArray
 ) -> dict[str, FloatArray]:
-    """MOTA, FN, FP and id-switch rates of one band per replicate (NaN where GT is 0);
-    ``column(name)`` gives the replicates' sums of the column ``kind/label/field``."""
-    gt = column(f"{kind}/{label}/num_gt")
-    matches = column(f"{kind}/{label}/num_matches")
-    fp = column(f"{kind}/{label}/fp") if with_fp else np.zeros_like(gt)
-    switches = column(f"{kind}/{label}/id_switches")
+    """MOTA, FN, id-switch and FP rates of bands per replicate ``(replicates, bands)`` (NaN
+    where GT is 0; the FP rate of an FP-free band is its MOTA's 0 FP, not a rate);
+    ``sums(field)`` gives the replicates' sums of each band's column ``kind/label/field``
+    ``(replicates, bands)``, ``with_fp`` whether each band counts false positives."""
+    gt = sums("num_gt")
+    matches = sums("num_matches")
+    fp = np.where(with_fp, sums("fp"), 0.0)
+    switches = sums("id_switches")
     with np.errstate(divide="ignore", invalid="ignore"):
         safe = np.where(gt > 0, gt, 1.0)
         out = {
             "mota": 1.0 - (gt - matches + fp + switches) / safe,
             "fn_rate": (gt - matches) / safe,
             "id_switch_rate": switches / safe,
+            "fp_rate": fp / safe,
         }
-        if with_fp:
-            out["fp_rate"] = fp / safe
     return {k: np.where(gt > 0, v, np.nan) for k, v in out.items()}

@@ -18,8 +18,10 @@ beside a report, which ``compare --significance`` reads for its paired bootstrap
 from __future__ import annotations
 
 import io
+import struct
 import zipfile
-from collections.abc import Sequence
+import zlib
+from collections.abc import Sequence, Sized
 from dataclasses import dataclass
 from typing import Any
 
@@ -120,18 +122,20 @@ class FrameTable:
     def save(self) -> bytes:
         """The table as ``.npz`` bytes (no pickle; uncompressed: compressing costs more time
         than the bytes are worth)."""
-        buf = io.BytesIO()
         arrays: dict[str, Any] = {
             "schema": np.array([FRAMES_SCHEMA], dtype=np.int64),
             "num_frames": np.array([self.num_frames], dtype=np.int64),
         }
+        # Indices are in range (check_table): they fit int32 when their largest possible do.
+        limits = np.array([self.num_frames, self.num_gt_tracks, self.num_tracks])
+        indices_fit = _fits32(limits - 1)
         for name, kind in _ARRAYS:
             value = getattr(self, name)
-            arrays[name] = value.astype(
-                np.int32 if kind == _INT and _fits32(value) else value.dtype
+            narrow = kind == _INT and (
+                (indices_fit and name not in ("gt_ids", "track_ids")) or _fits32(value)
             )
-        np.savez(buf, **arrays)
-        return buf.getvalue()
+            arrays[name] = value.astype(np.int32 if narrow else value.dtype)
+        return _npz(arrays)
 
     @staticmethod
     def load(data: bytes) -> FrameTable:
@@ -161,6 +165,38 @@ class FrameTable:
                 {_INT: np.int64, _FLOAT: np.float64, _BOOL: np.bool_}[kind], copy=False
             )
         return FrameTable(num_frames=int(num_frames[0]), **out)
+
+
+#: The fixed start of a ZIP local file header and of a central directory entry (little-endian):
+#: version needed 4.5 (ZIP64) and made by 4.5 on Unix, no flags, stored, dated 1980-01-01.
+_LOCAL_START = b"PK\x03\x04" + struct.pack("<2B4H", 45, 0, 0, 0, 0, (1 << 5) | 1)
+_CENTRAL_START = b"PK\x01\x02" + struct.pack("<4B4H", 45, 3, 45, 0, 0, 0, 0, (1 << 5) | 1)
+
+
+def _npz(arrays: dict[str, NDArray[Any]]) -> bytes:
+    """The bytes ``numpy.savez`` writes for ``arrays`` (``zipfile`` with ``force_zip64``),
+    without its file objects per entry: each ``<name>.npy`` stored uncompressed, its sizes
+    in a ZIP64 extra field, a central directory, the end record. ``numpy.load`` reads it."""
+    entries: list[bytes] = []
+    central: list[bytes] = []
+    offset = 0
+    for name, array in arrays.items():
+        npy = io.BytesIO()
+        np.lib.format.write_array_header_1_0(npy, np.lib.format.header_data_from_array_1_0(array))
+        data = npy.getvalue() + array.tobytes()
+        crc, size, filename = zlib.crc32(data), len(data), f"{name}.npy".encode("ascii")
+        local = struct.pack("<3L2H", crc, 0xFFFFFFFF, 0xFFFFFFFF, len(filename), 20)
+        sizes = struct.pack("<2H2Q", 1, 16, size, size)  # ZIP64 extra field: the sizes
+        entries.append(_LOCAL_START + local + filename + sizes + data)
+        entry = struct.pack(
+            "<3L5H2L", crc, size, size, len(filename), 0, 0, 0, 0, 0o600 << 16, offset
+        )
+        central.append(_CENTRAL_START + entry + filename)
+        offset += len(entries[-1])
+    directory = b"".join(central)
+    count = len(central)
+    end = b"PK\x05\x06" + struct.pack("<4H2LH", 0, 0, count, count, len(directory), offset, 0)
+    return b"".join(entries) + directory + end
 
 
 def _fits32(value: IntArray) -> bool:
@@ -215,7 +251,8 @@ def check_table(t: FrameTable) -> None:
             raise ValueError(f"frames table: {name} holds a non-finite value")
 
 
-def _frames_of(per_frame: Sequence[NDArray[Any]]) -> IntArray:
+def frames_of(per_frame: Sequence[Sized]) -> IntArray:
+    """The frame of each row of ``per_frame`` (one collection per frame) flattened."""
     lengths = np.fromiter((len(a) for a in per_frame), dtype=np.int64, count=len(per_frame))
     return np.repeat(np.arange(len(per_frame), dtype=np.int64), lengths)
 
@@ -255,17 +292,17 @@ def build_table(
         num_frames=len(gts),
         gt_ids=np.asarray(gt_ids, dtype=np.int64),
         track_ids=np.asarray(track_ids, dtype=np.int64),
-        gt_frame=_frames_of(gts),
+        gt_frame=frames_of(gts),
         gt_index=_cat(gts, np.int64),
-        track_frame=_frames_of(tracks),
+        track_frame=frames_of(tracks),
         track_index=_cat(tracks, np.int64),
-        match_frame=_frames_of(match_gt),
+        match_frame=frames_of(match_gt),
         match_gt=_cat(match_gt, np.int64),
         match_track=_cat(match_track, np.int64),
         match_switch=_cat(match_switch, np.bool_),
         match_recall=_cat(match_recall, np.bool_),
         match_value=_cat(match_value, np.float64),
-        potential_frame=_frames_of(potential),
+        potential_frame=frames_of(potential),
         potential_gt=keys // num_tracks,
         potential_track=keys % num_tracks,
         hota_frame=_cat(h_frames, np.int64)[useful],
