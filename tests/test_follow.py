@@ -154,7 +154,7 @@ def test_the_method_runs_on_one_opencv_thread_and_its_cpu_time_excludes_renderin
     import cv2
 
     from rgbd_eval import follow as follow_module
-    from rgbd_eval.detect.protocol import create_detector as real
+    from rgbd_eval.components import create_detector as real
 
     seen: list[int] = []
 

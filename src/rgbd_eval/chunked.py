@@ -24,8 +24,9 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig
-from rgbd_eval.detect.protocol import ResumableDetector, create_detector
+from rgbd_eval.detect.protocol import ResumableDetector
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.reader import Recording
 from rgbd_eval.pipeline import SequenceDetections, detect_sequence

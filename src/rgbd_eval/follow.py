@@ -39,8 +39,8 @@ from numpy.typing import NDArray
 
 from rgbd_eval import exact
 from rgbd_eval.atomic import write_json, write_text
+from rgbd_eval.components import create_detector, create_tracker
 from rgbd_eval.config import RunConfig, config_to_dict, load_config
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter
@@ -58,7 +58,6 @@ from rgbd_eval.sim.synth import (
     write_frame,
     write_static,
 )
-from rgbd_eval.track.protocol import create_tracker
 from rgbd_eval.types import Frame, GroundTruthObject, Pose, Stream, TrackOutput
 
 Status = Literal["searching", "following", "wrong", "lost"]

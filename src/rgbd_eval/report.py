@@ -8,7 +8,6 @@ later ``compare`` could mistake for a result.
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
 from collections.abc import Callable, Sequence
 from dataclasses import asdict
@@ -18,6 +17,7 @@ from typing import Any
 
 from rgbd_eval import __version__
 from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
+from rgbd_eval.files import file_digest
 from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
 from rgbd_eval.outdir import OutputFolder
@@ -65,19 +65,6 @@ MATCHING = {
     Convention.MOTMETRICS: "motmetrics 1.4: a previous match is kept while it stays within "
     "the gate, however long ago; MT means tracked in 80% of frames or more",
 }
-
-
-def file_digest(path: Path) -> str:
-    """sha256 of a file, or of a folder's files (names and contents, sorted)."""
-    h = hashlib.sha256()
-    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
-    for f in files:
-        if path.is_dir():
-            h.update(str(f.relative_to(path)).encode())
-        with f.open("rb") as handle:
-            for block in iter(lambda: handle.read(1 << 20), b""):
-                h.update(block)
-    return h.hexdigest()
 
 
 def library_versions() -> dict[str, str]:

@@ -15,10 +15,11 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rgbd_eval.cache import DetectionCache, detection_key
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig, build_config, load_config, load_paper
 from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError, InputError, TaskError
+from rgbd_eval.files import file_digest
 from rgbd_eval.methods.basso2012 import CLUTTER, SCENARIOS
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.metrics.gating import iou_matrix
@@ -31,7 +32,6 @@ from rgbd_eval.pipeline import (
     sequence_name,
     track_sequence,
 )
-from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 

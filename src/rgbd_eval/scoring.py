@@ -17,6 +17,7 @@ from typing import Any
 from rgbd_eval import __version__
 from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
+from rgbd_eval.files import file_digest
 from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
 from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
@@ -26,7 +27,6 @@ from rgbd_eval.report import (
     MATCHING,
     REPORT_SCHEMA_VERSION,
     events_csv,
-    file_digest,
     format_value,
     library_versions,
 )

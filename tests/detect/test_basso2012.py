@@ -11,8 +11,8 @@ import dataclasses
 import numpy as np
 import pytest
 
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import build_config
-from rgbd_eval.detect import create_detector
 from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
 from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
 from rgbd_eval.detect.basso2012_config import GroundMode, HogBorder, HogClassifier

@@ -164,6 +164,7 @@ def run(
                 results.append(run_sequence(recordings[0], config, gt, advance_callback(bar, task)))
         else:  # a task per recording on the cluster; results come back, this process writes
             from rgbd_eval.engine import connect, map_ordered, parse_cluster
+            from rgbd_eval.sweep import warm_up
 
             spec = parse_cluster(cluster, tasks=len(recordings))
             remote = spec.address is not None  # remote workers do not share our working dir
@@ -171,7 +172,7 @@ def run(
                 (p.resolve() if remote else p, config, gt.resolve() if gt and remote else gt)
                 for p in recordings
             ]
-            with connect(spec) as client, progress_bar() as bar:
+            with connect(spec, warm_up=warm_up) as client, progress_bar() as bar:
                 task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
                 results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
         with progress_bar() as bar:

@@ -96,11 +96,12 @@ def score(
             sequences = [score_sequence(name, t, g, *rest) for name, t, g in pairs]
         else:  # a task per sequence; results come back, this process writes the report
             from rgbd_eval.engine import connect, map_ordered, parse_cluster
+            from rgbd_eval.sweep import warm_up
 
             spec = parse_cluster(cluster, tasks=len(pairs))
             if spec.address is not None:  # remote workers do not share our working directory
                 pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
-            with connect(spec) as client:
+            with connect(spec, warm_up=warm_up) as client:
                 sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
         report = write_report(
             folder,

@@ -148,6 +148,7 @@ def sweep(
         parse_param,
         point_configs,
         run_sweep,
+        warm_up,
     )
 
     specs: list[SweepParam] = [parse_param(p) for p in params or []]
@@ -196,7 +197,7 @@ def sweep(
     )
     with folder:  # checked and staged before the sweep; published whole or not at all
         start = time.perf_counter()
-        with connect(spec) as client, progress_bar() as bar:
+        with connect(spec, warm_up=warm_up) as client, progress_bar() as bar:
             tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
             result = run_sweep(
                 recordings,

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rgbd_eval.components import create_tracker
 from rgbd_eval.config import build_config, load_config, load_paper
 from rgbd_eval.errors import ConfigError, TaskError
 from rgbd_eval.io.groundtruth import GroundTruth
@@ -28,7 +29,6 @@ from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
-from rgbd_eval.track.protocol import create_tracker
 from rgbd_eval.types import Box2D
 
 #: The summary measures shown per ablation variant.

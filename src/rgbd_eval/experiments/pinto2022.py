@@ -20,8 +20,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from rgbd_eval.components import create_detector, create_tracker
 from rgbd_eval.config import load_config, load_paper
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
 from rgbd_eval.metrics import Counts, summarize, total
@@ -29,7 +29,6 @@ from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.track.pinto2022_config import Pinto2022TrackerConfig
-from rgbd_eval.track.protocol import create_tracker
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
