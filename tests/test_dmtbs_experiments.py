@@ -17,7 +17,8 @@ from rgbd_eval.experiments.dmtbs import (
     yaw_error,
 )
 from rgbd_eval.methods.dmtbs import check_claims
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.tof import TofFrame, TofImage
 from rgbd_eval.track.dmtbs import DmtbsTrackerConfig

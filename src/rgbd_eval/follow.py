@@ -45,10 +45,11 @@ from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter
 from rgbd_eval.sim import rig
+from rgbd_eval.sim.rig_config import StereoPairConfig
 from rgbd_eval.sim.rig_sensors import make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.simulate import Simulator
-from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig
+from rgbd_eval.sim.stereo_rig import StereoPair
 from rgbd_eval.sim.synth import (
     OWNER,
     SynthContainer,

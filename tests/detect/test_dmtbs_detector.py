@@ -16,7 +16,8 @@ from rgbd_eval.detect.dmtbs import (
     FloorSource,
 )
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
 from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
 
 METHOD_FILE = Path(__file__).parents[2] / "configs" / "methods" / "dmtbs.yaml"

@@ -53,7 +53,7 @@ def reproduce(
     from rgbd_eval.cache import DetectionCache
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.report_html import reproduce_page
-    from rgbd_eval.sim import ensure_scenario
+    from rgbd_eval.sim.synth import ensure_scenario
     from rgbd_eval.sweep import warm_up
 
     # Every option is checked before the scenarios are generated (that takes minutes).

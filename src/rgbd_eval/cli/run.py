@@ -68,7 +68,7 @@ def expand_inputs(paths: list[Path]) -> list[Path]:
 
 def ensure_demo() -> Path:
     """The demo recording, generated on first use (deterministic, a few seconds)."""
-    from rgbd_eval.sim import demo_recording  # imported lazily: open3d is slow to import
+    from rgbd_eval.sim.synth import demo_recording  # imported lazily: open3d is slow to import
 
     path = default_demo()
     if not path.exists():

@@ -66,9 +66,10 @@ def synth(
 ) -> None:
     """Render scenarios to ROS1 .bag or ROS2 .mcap plus a <name>.gt.csv sidecar; deterministic for a seed."""
     from rgbd_eval.config import parse_overrides
-    from rgbd_eval.sim import dataset_path, load_scenario, scenario_paths, synthesize, write_preview
+    from rgbd_eval.sim.preview import write_preview
+    from rgbd_eval.sim.scenario import load_scenario, scenario_paths
     from rgbd_eval.sim.stereo_rig import with_stereo_rig
-    from rgbd_eval.sim.synth import OWNER, ground_truth_path
+    from rgbd_eval.sim.synth import OWNER, dataset_path, ground_truth_path, synthesize
 
     changes = parse_overrides(overrides or [])
     if rig not in (None, "stereo"):

@@ -20,7 +20,7 @@ from rgbd_eval.config import EvaluationConfig, Gating
 from rgbd_eval.detect.dmtbs import BackgroundMethod, DepthView, DmtbsDetector, DmtbsDetectorConfig
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize
 from rgbd_eval.metrics.selection import is_scored_track
-from rgbd_eval.sim.rig_sensors import StaticDepthConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
 from rgbd_eval.sim.scenario import Obstacle, Scenario
 from rgbd_eval.sim.tof import TofFrame, TofRig
 from rgbd_eval.track.dmtbs import DmtbsTracker, DmtbsTrackerConfig

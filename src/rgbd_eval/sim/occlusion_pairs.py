@@ -21,9 +21,10 @@ from numpy.typing import NDArray
 
 from rgbd_eval import exact
 from rgbd_eval.sim.annotate import projected_extent
+from rgbd_eval.sim.rig_config import ThermalCameraConfig
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.simulate import Simulator
-from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig, counts_to_celsius
+from rgbd_eval.sim.thermal_camera import ThermalCamera, counts_to_celsius
 from rgbd_eval.sim.world import NO_HIT
 
 Box = tuple[float, float, float, float]
