@@ -14,7 +14,7 @@ from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.detect.basso2012 import Basso2012Detector
 from rgbd_eval.detect.ground import GroundState
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.io.reader import Recording
+from rgbd_eval.io.recording import Recording
 from rgbd_eval.pipeline import detect_sequence, open_for
 from rgbd_eval.sim import load_scenario, synthesize
 

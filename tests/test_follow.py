@@ -20,7 +20,7 @@ from rgbd_eval.follow import (
     wheel_command,
     write_follow,
 )
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import parse_scenario

@@ -17,7 +17,7 @@ from rgbd_eval.config import Gating, RunConfig
 from rgbd_eval.detect.protocol import ResumableDetector
 from rgbd_eval.errors import ConfigError, GroundTruthError, InputError, ScoringError
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
-from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
+from rgbd_eval.io.recording import Recording, RecordingInfo, open_recording
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence
 from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
 from rgbd_eval.types import Detection, Frame, GroundTruthObject, TrackOutput

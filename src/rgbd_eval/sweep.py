@@ -69,7 +69,7 @@ from rgbd_eval.errors import (
 )
 from rgbd_eval.files import file_digest
 from rgbd_eval.io.groundtruth import GroundTruth
-from rgbd_eval.io.reader import Recording
+from rgbd_eval.io.recording import Recording
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import (
     GroundTruthMatch,

@@ -61,7 +61,7 @@ def rendered_frames(size: tuple[int, int], n: int = 40) -> list[Frame]:
 def main(argv: Sequence[str]) -> None:
     cv2.setNumThreads(1)
     if argv:
-        from rgbd_eval.io.reader import open_recording
+        from rgbd_eval.io.recording import open_recording
 
         for path in argv:
             time_frames(path, list(open_recording(path).frames()))

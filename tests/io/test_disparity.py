@@ -12,7 +12,7 @@ from rgbd_eval.detect import stereo
 from rgbd_eval.errors import DecodeError
 from rgbd_eval.io.images import encode_depth_raw
 from rgbd_eval.io.messages import DISPARITY_TYPE, IMAGE_TYPE
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import RecordingWriter
 
 from .conftest import PERIOD, RGB_CAM, T0, rgb_image

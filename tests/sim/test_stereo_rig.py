@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from rgbd_eval.detect import stereo
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import Simulator, parse_scenario, synthesize
 from rgbd_eval.sim.rig_config import StereoPairConfig

@@ -22,7 +22,7 @@ import numpy as np
 from rgbd_eval.detect.reid import ColourTextureEmbedder, Embedder, builtin_mobilenet
 from rgbd_eval.detect.reid_calibration import calibrate, pair_distances, roc_auc
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 
 MIN_VISIBILITY = 0.95
 MIN_HEIGHT_PX = 80.0

@@ -32,7 +32,7 @@ import numpy as np
 from rgbd_eval.detect.person2d import ColourImage, PersonBox
 from rgbd_eval.detect.ssdlite import SsdLiteDetector, SsdParams
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.metrics.gating import iou_matrix
 from rgbd_eval.types import GroundTruthObject
 
