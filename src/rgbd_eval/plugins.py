@@ -136,8 +136,11 @@ class MethodSpec:
     #: The seed (paper text) that specifies it, e.g. ``000`` (see DESIGN.md).
     seed: str = ""
     gating: str = "iou"
-    #: Where the paper's defaults live, relative to the config folder.
-    config_file: str | None = None
+    #: The method's default config (``method.yaml``): an absolute path (a method package's own
+    #: file), or one relative to the config folder.
+    config_file: str | Path | None = None
+    #: The paper's published numbers and claim thresholds (``paper.yaml``), likewise.
+    paper_file: str | Path | None = None
 
 
 @dataclass(frozen=True)
@@ -146,13 +149,29 @@ class PaperSpec:
 
     ``scenarios`` are the synthetic recordings it needs (scenario names or YAML paths);
     ``run`` gets them as ``{name: recording path}`` plus the options, and returns the
-    result to write.
+    result to write. It may be named as ``"module:function"``, imported when the paper is
+    reproduced (:meth:`experiments`): a method's experiments drive runs and sweeps, which
+    find methods through this registry, so a method package names its experiments rather
+    than importing them.
     """
 
     method: str
     title: str
     scenarios: tuple[str, ...]
-    run: Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult]
+    run: Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult] | str
+
+    def experiments(self) -> Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult]:
+        """The function that runs the experiments (``run``, imported when named)."""
+        if not isinstance(self.run, str):
+            return self.run
+        module, sep, name = self.run.partition(":")
+        try:
+            run = getattr(importlib.import_module(module), name) if sep else None
+        except (ImportError, AttributeError) as err:
+            raise ConfigError(f"paper {self.method!r}: cannot load {self.run!r}: {err}") from err
+        if not callable(run):
+            raise ConfigError(f"paper {self.method!r}: {self.run!r} is not a 'module:function'")
+        return run  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True)

@@ -20,8 +20,8 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
+from rgbd_eval.methods.basso2012.detector import STAGES, Basso2012Detector
+from rgbd_eval.methods.basso2012.detector_config import Basso2012DetectorConfig as DetectorConfig
 from rgbd_eval.types import Frame
 
 from .scenes import Block, Person, Scene, camera_pose, render

@@ -16,6 +16,7 @@ from rgbd_eval.compare import compare_reports
 from rgbd_eval.config import Gating, load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.files import file_digest
+from rgbd_eval.methods.basso2012.experiments import Claim, Reproduction, to_json
 from rgbd_eval.metrics import Counts
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import ReproduceResult
@@ -27,7 +28,6 @@ from rgbd_eval.report_html import (
     write_run_html,
     write_sweep_html,
 )
-from rgbd_eval.reproduce import Claim, Reproduction, to_json
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import SweepRecord, SweepResult
 

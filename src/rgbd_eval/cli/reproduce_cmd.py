@@ -73,7 +73,7 @@ def reproduce(
             options = ReproduceOptions(
                 client=client, cache=cache, progress=lambda m: err_console.print(m)
             )
-            result = spec.run(recordings, options)
+            result = spec.experiments()(recordings, options)
         staging = folder.staging
         write_text(staging / "reproduce.md", result.markdown)
         write_json(staging / "reproduce.json", {"method": system, **result.data})

@@ -31,6 +31,7 @@ register_method(
         seed="004",
         gating="iou",
         config_file="methods/cielniak2010.yaml",
+        paper_file="papers/cielniak2010.yaml",
     )
 )
 

@@ -36,6 +36,7 @@ register_method(
         seed="001",
         gating="metric",
         config_file="methods/pinto2022.yaml",
+        paper_file="papers/pinto2022.yaml",
     )
 )
 

@@ -23,6 +23,7 @@ register_method(
         seed="002",
         gating="metric",
         config_file="methods/satake2009.yaml",
+        paper_file="papers/satake2009.yaml",
     )
 )
 

@@ -404,12 +404,13 @@ class ClaimRow:
 
 
 def paper_file(method: str) -> dict[str, Any] | None:
-    """The published numbers of ``method``'s paper (``configs/papers/<method>.yaml``), if any."""
-    from rgbd_eval.config import config_dir
-    from rgbd_eval.reproduce import paper_values
+    """The published numbers of ``method``'s paper (its ``paper.yaml``), if any."""
+    from rgbd_eval.config import load_paper, paper_path
 
-    path = config_dir() / "papers" / f"{method}.yaml"
-    return paper_values(path) if path.is_file() else None
+    path = paper_path(method)
+    if path is None or not path.is_file():
+        return None
+    return load_paper(method, mappings=("tables", "figures", "claims"), path=path)
 
 
 def _claims(result: ReproduceResult) -> list[ClaimRow]:
@@ -433,7 +434,7 @@ def reproduce_page(
     """``reproduce.html``: per table the paper's value beside ours, the claims, the figures redrawn.
 
     Reads the result's JSON data: ``tables`` (table -> row -> measured summary) beside
-    the paper's tables of the same keys (``paper``, by default ``configs/papers/<method>.yaml``);
+    the paper's tables of the same keys (``paper``, by default the method's ``paper.yaml``);
     ``track_lengths`` and ``voxel_timing_ms`` where the paper has those figures (basso2012's
     Figures 7.7 and 7.9).
     """

@@ -9,15 +9,8 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from rgbd_eval.config import ComponentConfig
+from rgbd_eval.detect.ground import GroundMode
 from rgbd_eval.detect.plane import normalise_plane, plane_from_points
-
-
-class GroundMode(enum.Enum):
-    """How the detector finds the ground plane first (seed 000, 5.1, 5.4.1)."""
-
-    AUTO = "auto"
-    POINTS = "points"
-    PLANE = "plane"
 
 
 class HogClassifier(enum.Enum):

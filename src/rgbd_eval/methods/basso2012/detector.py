@@ -23,12 +23,6 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.detect.authors_hog import PersonWindow, person_confidences
-from rgbd_eval.detect.basso2012_config import (
-    Basso2012DetectorConfig,
-    GroundMode,
-    HogBorder,
-    HogClassifier,
-)
 from rgbd_eval.detect.cloud import (
     PointCloud,
     VoxelGrid,
@@ -44,7 +38,16 @@ from rgbd_eval.detect.clustering import (
     merge_close_clusters,
     split_by_heads,
 )
-from rgbd_eval.detect.features import (
+from rgbd_eval.detect.ground import GroundMode, GroundPlaneEstimator, GroundState
+from rgbd_eval.detect.hog import hog_confidences
+from rgbd_eval.detect.plane import signed_heights
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.basso2012.detector_config import (
+    Basso2012DetectorConfig,
+    HogBorder,
+    HogClassifier,
+)
+from rgbd_eval.methods.basso2012.features import (
     ClusterGeometry,
     RgbProjection,
     blob,
@@ -56,10 +59,6 @@ from rgbd_eval.detect.features import (
     project_to_rgb,
     touches_border,
 )
-from rgbd_eval.detect.ground import GroundPlaneEstimator, GroundState
-from rgbd_eval.detect.hog import hog_confidences
-from rgbd_eval.detect.plane import signed_heights
-from rgbd_eval.errors import ConfigError
 from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Box2D, Box3D, CameraModel, Detection, Frame
 

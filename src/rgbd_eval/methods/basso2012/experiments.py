@@ -2,7 +2,7 @@
 
 Every table is produced by the sweep engine (detections computed once per
 sequence and detector config, then tracked and scored per setting) and shown
-beside the published values from ``configs/papers/basso2012.yaml``. Each claim
+beside the published values from ``methods/basso2012/paper.yaml``. Each claim
 of the thesis is checked by a small predicate on the measured numbers.
 """
 
@@ -17,10 +17,10 @@ from typing import TYPE_CHECKING, Any
 from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig, build_config, load_config, load_paper
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig
 from rgbd_eval.errors import ConfigError, InputError, TaskError
 from rgbd_eval.files import file_digest
 from rgbd_eval.methods.basso2012 import CLUTTER, SCENARIOS
+from rgbd_eval.methods.basso2012.detector_config import Basso2012DetectorConfig
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.metrics.gating import iou_matrix
 from rgbd_eval.pipeline import (
@@ -32,6 +32,7 @@ from rgbd_eval.pipeline import (
     sequence_name,
     track_sequence,
 )
+from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
@@ -44,7 +45,7 @@ THRESHOLDS = (0.5, 0.0, -0.5, -1.0, -1.5, -1.75, -2.0, -2.5, -3.0)  # Table 7.6
 #: The clutter variant: static de-validation over the thesis' fake-track window
 #: (Table 6.1 frames_before_fake 60 at 30 Hz = 2 s); None is the thesis' tracker.
 STATIC_VARIANT = ("tracker.static_devalidation_s", (None, 2.0))
-#: Figure 7.9's phases (7.2) as sums of our detector's stages (``detect.basso2012.STAGES``).
+#: Figure 7.9's phases (7.2) as sums of our detector's stages (``detector.STAGES``).
 #: The thesis does not name the voxel grid as a phase; it is kept apart.
 PHASES: dict[str, tuple[str, ...]] = {
     "read": ("read", "pointcloud"),
@@ -66,7 +67,7 @@ def _detector(config: RunConfig) -> Basso2012DetectorConfig:
 
 
 def paper_values(path: Path | None = None) -> dict[str, Any]:
-    """The published numbers and claim thresholds (``configs/papers/basso2012.yaml``)."""
+    """The published numbers and claim thresholds (``methods/basso2012/paper.yaml``)."""
     return load_paper("basso2012", mappings=("tables", "figures", "claims"), path=path)
 
 
@@ -400,7 +401,7 @@ def check_claims(
 ) -> list[Claim]:
     """The thesis' statements of chapter 7, each judged on the measured numbers.
 
-    ``claims`` is the ``claims`` mapping of ``configs/papers/basso2012.yaml``: per
+    ``claims`` is the ``claims`` mapping of ``methods/basso2012/paper.yaml``: per
     statement the thesis' sentence and the thresholds it is judged by. ``paper``
     (default: that file) gives the published per-sequence MOTA for the first claim.
     """
@@ -750,3 +751,15 @@ def to_json(res: Reproduction) -> dict[str, Any]:
         "misses": res.misses,
         "claims": [c.__dict__ for c in res.claims],
     }
+
+
+def reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
+    """``rgbd-eval reproduce basso2012``: the tables, figures and claims of chapter 7."""
+    res = reproduce_basso2012(
+        recordings, client=options.client, cache=options.cache, progress=options.progress
+    )
+    return ReproduceResult(
+        markdown=render_markdown(res, paper_values()),
+        data=to_json(res),
+        claims=tuple((c.sentence, c.held) for c in res.claims),
+    )

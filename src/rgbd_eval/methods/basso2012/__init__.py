@@ -1,18 +1,20 @@
-"""basso2012: RGB-D people tracking by detection for a mobile robot (seed 000, the reference)."""
+"""basso2012: RGB-D people tracking by detection for a mobile robot (seed 000, the reference).
+
+The package holds the detector (:mod:`.detector`, its config :mod:`.detector_config`, the
+per-cluster features :mod:`.features`), the tracker (:mod:`.tracker`, :mod:`.tracker_config`),
+the defaults (``method.yaml``), the thesis' numbers and claims (``paper.yaml``) and the
+experiments of ``rgbd-eval reproduce basso2012`` (:mod:`.experiments`); see ``README.md``.
+Importing it registers the detector, the tracker, the method and the paper.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from pathlib import Path
 
-from rgbd_eval.plugins import (
-    MethodSpec,
-    PaperSpec,
-    ReproduceOptions,
-    ReproduceResult,
-    register_method,
-    register_paper,
-)
+from rgbd_eval.methods.basso2012 import detector, tracker  # noqa: F401  (they register)
+from rgbd_eval.plugins import MethodSpec, PaperSpec, register_method, register_paper
+
+HERE = Path(__file__).resolve().parent
 
 #: The thesis test set (seed 000, chapter 7).
 SCENARIOS = (
@@ -35,22 +37,10 @@ register_method(
         title="RGB-D people tracking by detection for a mobile robot (Basso, thesis 2012)",
         seed="000",
         gating="iou",
-        config_file="methods/basso2012.yaml",
+        config_file=HERE / "method.yaml",
+        paper_file=HERE / "paper.yaml",
     )
 )
-
-
-def _reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
-    from rgbd_eval.reproduce import paper_values, render_markdown, reproduce_basso2012, to_json
-
-    res = reproduce_basso2012(
-        recordings, client=options.client, cache=options.cache, progress=options.progress
-    )
-    return ReproduceResult(
-        markdown=render_markdown(res, paper_values()),
-        data=to_json(res),
-        claims=tuple((c.sentence, c.held) for c in res.claims),
-    )
 
 
 register_paper(
@@ -58,6 +48,6 @@ register_paper(
         method="basso2012",
         title="seed 000 chapter 7: Tables 7.1-7.6, Figures 7.7 and 7.9",
         scenarios=(*SCENARIOS, *CLUTTER),
-        run=_reproduce,
+        run="rgbd_eval.methods.basso2012.experiments:reproduce",
     )
 )

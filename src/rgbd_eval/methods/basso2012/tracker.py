@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval.methods.basso2012.tracker_config import Basso2012TrackerConfig, ClusterSelection
 from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import ukf
 from rgbd_eval.track.association import (
@@ -54,7 +55,6 @@ from rgbd_eval.track.association import (
     mahalanobis_sq,
     score_assign,
 )
-from rgbd_eval.track.basso2012_config import Basso2012TrackerConfig, ClusterSelection
 from rgbd_eval.track.boosting import OnlineBoostingClassifier, integral_histograms
 from rgbd_eval.track.motion import (
     apply_measurement,
