@@ -24,11 +24,11 @@ from rgbd_eval.components import create_detector, create_tracker
 from rgbd_eval.config import load_config, load_paper
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
+from rgbd_eval.methods.pinto2022.tracker_config import Pinto2022TrackerConfig
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
-from rgbd_eval.track.pinto2022_config import Pinto2022TrackerConfig
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
@@ -251,7 +251,7 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
 
 
 def paper_values() -> dict[str, Any]:
-    """The published numbers (``configs/papers/pinto2022.yaml``)."""
+    """The published numbers (``methods/pinto2022/paper.yaml``)."""
     return load_paper("pinto2022")
 
 

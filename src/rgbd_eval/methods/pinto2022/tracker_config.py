@@ -3,7 +3,7 @@
 The motion and track-management values are the seed's. The appearance thresholds are
 Euclidean distances in the units of the detector's embedder: the seed's 300 / 700 / 400
 (eqs. 17-18) are TriNet's; the defaults here are those of the default embedder
-(``colour_texture``), calibrated as ``configs/methods/pinto2022.yaml`` records.
+(``colour_texture``), calibrated as ``methods/pinto2022/method.yaml`` records.
 ``appearance`` names the embedder the thresholds belong to, so that a detector with
 another embedder is refused instead of being gated in the wrong units.
 """

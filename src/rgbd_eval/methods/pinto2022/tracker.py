@@ -39,9 +39,9 @@ from numpy.typing import NDArray
 from scipy.optimize import linear_sum_assignment
 
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.pinto2022.tracker_config import Pinto2022TrackerConfig
 from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import kalman
-from rgbd_eval.track.pinto2022_config import Pinto2022TrackerConfig
 from rgbd_eval.types import Box2D, Detection, Frame, TrackOutput, TrackStatus, Visibility
 
 Array = NDArray[np.float64]

@@ -19,13 +19,6 @@ from collections.abc import Mapping
 from rgbd_eval.detect.hog_people import HogParams, HogPeopleDetector
 from rgbd_eval.detect.localise import DepthView, localise
 from rgbd_eval.detect.person2d import ColourImage, PersonDetector2D
-from rgbd_eval.detect.pinto2022_config import (
-    PersonBackend,
-    PersonDetectorConfig,
-    Pinto2022DetectorConfig,
-    ReidBackend,
-    ReidConfig,
-)
 from rgbd_eval.detect.recorded import RecordedDetector, RecordedParams
 from rgbd_eval.detect.reid import (
     ColourTextureEmbedder,
@@ -37,6 +30,13 @@ from rgbd_eval.detect.reid import (
 from rgbd_eval.detect.ssdlite import SsdLiteDetector, SsdParams
 from rgbd_eval.detect.yolo_onnx import OnnxYoloDetector, YoloLayout, YoloParams
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.pinto2022.detector_config import (
+    PersonBackend,
+    PersonDetectorConfig,
+    Pinto2022DetectorConfig,
+    ReidBackend,
+    ReidConfig,
+)
 from rgbd_eval.plugins import DetectionContract, DetectorSpec, StreamSpec, register_detector
 from rgbd_eval.types import Detection, Frame
 
