@@ -92,7 +92,7 @@ def synth(
     if out is not None:  # the recording, its ground truth and (--follow) its following record
         targets += [out, ground_truth_path(out)]
         if follow is not None:
-            from rgbd_eval.follow import follow_paths
+            from rgbd_eval.methods.satake2009.follow import follow_paths
 
             targets += follow_paths(out)
     for target in targets:
@@ -145,7 +145,7 @@ def _follow(
     advance: Callable[[int, int], None],
 ) -> None:
     """``synth --follow``: the closed loop, its recording and its following record."""
-    from rgbd_eval.follow import follow, write_follow
+    from rgbd_eval.methods.satake2009.follow import follow, write_follow
     from rgbd_eval.sim.synth import ground_truth_path
 
     try:

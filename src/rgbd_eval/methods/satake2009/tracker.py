@@ -11,10 +11,10 @@ speeds hold). Without odometry the robot stands still.
 Per frame (2.4 step 2): each track is predicted (eq. 5), its head top projected into
 the left image with eq. (1), and the distance templates, made for its predicted distance
 (2.4 step 2.2), are searched around it
-(:func:`rgbd_eval.detect.satake2009_search.search_around`: a window of
+(:func:`rgbd_eval.methods.satake2009.search.search_around`: a window of
 ``search_sigmas`` predicted standard deviations, best template wins; ``search_steps``
 adds distances around the predicted one); a match above the detector's ``min_score``
-that passes its colour test (:mod:`rgbd_eval.detect.satake2009_colour`) inside the
+that passes its colour test (:mod:`rgbd_eval.methods.satake2009.colour`) inside the
 chi-square gate is the track's observation ``y_t`` (eq. 4), nearest tracks first so that
 an occluder is claimed by its own track. Tracks the search misses are then associated
 with the detector's whole-image detections (world frame, moved into the robot frame)
@@ -25,9 +25,9 @@ other method.
 This is the tracker reading the frame (``needs_frame``), not a detector taking hints:
 the detector's output stays a pure function of the frame, so it caches, and the search
 that depends on the tracks lives with them. The depth image is the detector's
-(shared per frame, :func:`~rgbd_eval.detect.satake2009_search.frame_depth`) and the
+(shared per frame, :func:`~rgbd_eval.methods.satake2009.search.frame_depth`) and the
 template settings come with the detector's contract
-(:class:`~rgbd_eval.detect.satake2009.Satake2009Contract`).
+(:class:`~rgbd_eval.methods.satake2009.detector.Satake2009Contract`).
 """
 
 from __future__ import annotations
@@ -42,13 +42,17 @@ import numpy as np
 from pydantic import Field
 
 from rgbd_eval.config import ComponentConfig
-from rgbd_eval.detect import satake2009_colour as colour
-from rgbd_eval.detect import satake2009_search as search
-from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
-from rgbd_eval.detect.satake2009 import Satake2009Contract, Satake2009DetectorConfig, head_point
+from rgbd_eval.methods.satake2009 import colour as colour
+from rgbd_eval.methods.satake2009 import ekf as ekf
+from rgbd_eval.methods.satake2009 import search as search
+from rgbd_eval.methods.satake2009 import templates as st
+from rgbd_eval.methods.satake2009.detector import (
+    Satake2009Contract,
+    Satake2009DetectorConfig,
+    head_point,
+)
 from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
-from rgbd_eval.track import satake2009_ekf as ekf
 from rgbd_eval.track.association import chi_square_gate, gnn_assign
 from rgbd_eval.types import (
     Box2D,

@@ -11,7 +11,7 @@ detection's position. These are the new-people detections of 2.4 step 3, a pure
 function of the frame (cacheable).
 
 The search around each track's prediction (2.4 steps 2.1-2.2) is the tracker's
-(:mod:`rgbd_eval.track.satake2009`): it needs the tracks, and reads this detector's
+(:mod:`rgbd_eval.methods.satake2009.tracker`): it needs the tracks, and reads this detector's
 settings from its :class:`Satake2009Contract`.
 """
 
@@ -27,10 +27,10 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from rgbd_eval.config import ComponentConfig
-from rgbd_eval.detect import satake2009_colour as colour
-from rgbd_eval.detect import satake2009_search as search
-from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
+from rgbd_eval.methods.satake2009 import colour as colour
+from rgbd_eval.methods.satake2009 import search as search
+from rgbd_eval.methods.satake2009 import templates as st
 from rgbd_eval.plugins import DetectionContract, DetectorSpec, register_detector
 from rgbd_eval.types import Box2D, CameraModel, Detection, Frame
 

@@ -120,7 +120,7 @@ def drive(
 ) -> tuple[float, float, float]:
     """The planar pose after ``dt`` at wheel speeds ``(v_L, v_R)`` (the arc of 2.3.1).
 
-    The arithmetic of :func:`rgbd_eval.track.satake2009_ekf.robot_motion`, in
+    The arithmetic of :func:`rgbd_eval.methods.satake2009.ekf.robot_motion`, in
     :mod:`rgbd_eval.exact`: the simulated robot's path is part of the recording, the same on
     every CPU.
     """

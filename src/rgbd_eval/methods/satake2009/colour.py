@@ -24,7 +24,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.detect.satake2009_templates import Match
+from rgbd_eval.methods.satake2009.templates import Match
 
 #: Rows of the head-to-hip box: the head is its top quarter, the torso its lower 55 %.
 HEAD_ROWS = (0.0, 0.25)

@@ -13,7 +13,7 @@ the share of pixels that agree -- a mask pixel agrees when its depth is within
 has no depth. A person-shaped region standing free of its background scores near 1;
 a wall (no free outline) or an empty floor scores low.
 
-Regenerate the shipped data with ``python -m rgbd_eval.detect.satake2009_templates``.
+Regenerate the shipped data with ``python -m rgbd_eval.methods.satake2009.templates``.
 """
 
 from __future__ import annotations
@@ -31,7 +31,7 @@ from numpy.typing import NDArray
 
 from rgbd_eval.types import CameraModel, Pose
 
-DATA = Path(__file__).resolve().parent.parent / "data" / "satake2009_templates.npz"
+DATA = Path(__file__).resolve().parent / "templates.npz"
 #: Focal length (px) the templates are stored at: a 100-degree camera 512 px wide.
 F_REF = 256.0 / math.tan(math.radians(50.0))
 D_REF = 2.0
@@ -320,7 +320,7 @@ def best_match(
 
 
 def main(argv: list[str]) -> int:
-    """Regenerate the shipped templates (``python -m rgbd_eval.detect.satake2009_templates``)."""
+    """Regenerate the shipped templates (``python -m rgbd_eval.methods.satake2009.templates``)."""
     path = Path(argv[0]) if argv else DATA
     path.parent.mkdir(parents=True, exist_ok=True)
     templates = build_templates()

@@ -26,8 +26,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.detect import satake2009_templates as st
 from rgbd_eval.detect import stereo
+from rgbd_eval.methods.satake2009 import templates as st
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.types import Frame
 

@@ -2,11 +2,11 @@
 
 Fig. 8 is a closed loop: the robot follows person A, detected first, while B and C pass
 between the robot and A. It runs here on ``configs/scenarios/satake2009_following.yaml``
-with :func:`rgbd_eval.follow.follow` (path C of section 3, the satake2009 tracker online),
+with :func:`rgbd_eval.methods.satake2009.follow.follow` (path C of section 3, the satake2009 tracker online),
 in memory. The tracks are scored against the exact ground truth (metric gating, the
 method's), and per person we count the scored frames, All Tr., Main Tr., the ids used,
 the ID switches, and the frames in which another person stood in front of them. Each
-claim of ``configs/papers/satake2009.yaml`` is judged on those numbers with the
+claim of ``methods/satake2009/paper.yaml`` is judged on those numbers with the
 thresholds written beside its sentence there.
 """
 
@@ -17,10 +17,11 @@ import os
 from collections import Counter
 from collections.abc import Mapping, Sequence
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 from typing import Any
 
 from rgbd_eval.config import load_config, load_paper
-from rgbd_eval.follow import FollowResult, FollowStep, follow
+from rgbd_eval.methods.satake2009.follow import FollowResult, FollowStep, follow
 from rgbd_eval.metrics import evaluate_sequence
 from rgbd_eval.metrics.clear import FrameEvents
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
@@ -29,7 +30,7 @@ from rgbd_eval.types import GroundTruthObject
 
 
 def paper_values() -> dict[str, Any]:
-    """``configs/papers/satake2009.yaml``: the seed's facts and the claims' thresholds."""
+    """``methods/satake2009/paper.yaml``: the seed's facts and the claims' thresholds."""
     return load_paper("satake2009", mappings=("timing", "fig8", "claims"))
 
 
@@ -312,7 +313,7 @@ def render_markdown(
         "",
         f"Scenario {s.scenario} (seed {s.seed}, {s.frames} frames at 20 fps, stereo pair at "
         "512x384): the robot follows person A with path C (section 3; v, k, d are ours, see "
-        "src/rgbd_eval/follow.py) while B and C cross between them; the satake2009 tracker "
+        "src/rgbd_eval/methods/satake2009/follow.py) while B and C cross between them; the satake2009 tracker "
         "runs online. Metric gating (1 m). The seed reports this experiment only in "
         "pictures: its claims are checked, there is no table to compare.",
         "",
@@ -368,3 +369,9 @@ def render_markdown(
         "",
     ]
     return "\n".join(lines)
+
+
+def reproduce(_recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceResult:
+    """``rgbd-eval reproduce satake2009``: the closed loop renders its own frames (its path
+    depends on the tracker), so no recordings are read."""
+    return run(options)
