@@ -41,10 +41,10 @@ from numpy.typing import NDArray
 from pydantic import Field
 
 from rgbd_eval.config import ComponentConfig
+from rgbd_eval.methods.dmtbs.blob_split import nearest_blob, split_centroids
 from rgbd_eval.plugins import DetectionContract, TrackerSpec, register_tracker
 from rgbd_eval.track import kalman
 from rgbd_eval.track.association import gnn_assign
-from rgbd_eval.track.blob_split import nearest_blob, split_centroids
 from rgbd_eval.track.motion import H, process_noise, transition_matrix
 from rgbd_eval.types import Detection, Frame, TrackOutput, TrackStatus, Visibility
 
@@ -56,7 +56,7 @@ TRACK_STAGES = ("kalman predict", "assignment + blob splitting", "kalman update 
 
 
 class DmtbsTrackerConfig(ComponentConfig):
-    """The DMT-BS tracker's parameters; the seed's table was lost, see configs/methods/dmtbs.yaml."""
+    """The DMT-BS tracker's parameters; the seed's table was lost, see methods/dmtbs/method.yaml."""
 
     name: Literal["dmtbs"] = "dmtbs"
 

@@ -7,7 +7,7 @@ connected components give the blobs (:mod:`.blobs`), one detection each, carryin
 (``footprint``) for the tracker's blob splitting.
 
 The seed's parameter table did not survive; the values chosen, with their reasons, are in
-``configs/methods/dmtbs.yaml`` and in the field descriptions below.
+``methods/dmtbs/method.yaml`` and in the field descriptions below.
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ class FloorSource(enum.Enum):
 
 
 class DmtbsDetectorConfig(ComponentConfig):
-    """The DMT-BS detector's parameters (values and reasons: configs/methods/dmtbs.yaml)."""
+    """The DMT-BS detector's parameters (values and reasons: methods/dmtbs/method.yaml)."""
 
     name: Literal["dmtbs"] = "dmtbs"
     background: BackgroundMethod = Field(
