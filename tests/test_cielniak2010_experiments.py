@@ -5,13 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 from rgbd_eval.config import load_config
-from rgbd_eval.experiments.cielniak2010 import (
+from rgbd_eval.io.groundtruth import from_objects
+from rgbd_eval.methods.cielniak2010.experiments import (
     check_claims,
     occluded_share,
     paper_values,
     plan_variants,
 )
-from rgbd_eval.io.groundtruth import from_objects
 from rgbd_eval.types import Box2D, GroundTruthObject
 
 

@@ -9,8 +9,10 @@ it reads, its paper and its default gating; a paper registers its experiments fo
 
 Discovery needs no hand-edited import list. :func:`load_plugins` imports
 
-1. every module of the packages :mod:`rgbd_eval.detect`, :mod:`rgbd_eval.track` and
-   :mod:`rgbd_eval.methods` (a package scan: a new module registers by existing);
+1. every package (or module) in :mod:`rgbd_eval.methods`, one per method, found by a
+   package scan (a new method registers by existing): its ``__init__`` registers the
+   detector, tracker, method and paper. The package is named, not imported, here: the
+   registry knows names and specs, and methods import it, never the other way;
 2. every entry point of the group ``rgbd_eval.plugins`` (installed third-party methods);
 3. every module named in ``$RGBD_EVAL_PLUGINS`` (comma-separated; for methods kept in a
    project's own folder, e.g. ``RGBD_EVAL_PLUGINS=my_lab.tracker``).
@@ -43,7 +45,7 @@ if TYPE_CHECKING:
 
 ENTRY_POINT_GROUP = "rgbd_eval.plugins"
 ENV_VAR = "RGBD_EVAL_PLUGINS"
-_SCANNED_PACKAGES = ("rgbd_eval.detect", "rgbd_eval.track", "rgbd_eval.methods")
+_SCANNED_PACKAGES = ("rgbd_eval.methods",)
 
 #: The stream roles a recording can hold (``io.topics.<role>``, ``--topic ROLE=/name``).
 #: Extra depth cameras of a rig are ``depth_2``, ``depth_3``, ... (see :func:`role_kind`).

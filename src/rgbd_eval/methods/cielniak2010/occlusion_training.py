@@ -5,7 +5,7 @@ both orders, ``f(a, b)`` labelled ``+1`` when ``a`` is in front and ``f(b, a) = 
 with the opposite label, so the classes are balanced and no feature can learn which slot
 the near person was drawn in. One classifier is trained per feature group (thermal,
 colour, both), as the paper compares them; accuracy is the share of held-out pairs whose
-front person :func:`rgbd_eval.track.occlusion.order` names correctly.
+front person :func:`rgbd_eval.methods.cielniak2010.occlusion.order` names correctly.
 """
 
 from __future__ import annotations
@@ -17,15 +17,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval.sim.occlusion_pairs import RenderedPair, overlapping_pairs
-from rgbd_eval.track.adaboost import train
-from rgbd_eval.track.occlusion import (
+from rgbd_eval.methods.cielniak2010.occlusion import (
     FEATURE_NAMES,
     GROUPS,
     OcclusionClassifier,
     OcclusionScene,
     pair_features,
 )
+from rgbd_eval.sim.occlusion_pairs import RenderedPair, overlapping_pairs
+from rgbd_eval.track.adaboost import train
 
 F64 = NDArray[np.float64]
 
@@ -36,7 +36,7 @@ class PairFeatures:
 
     x: F64
     a_in_front: NDArray[np.bool_]
-    #: what :func:`~rgbd_eval.track.occlusion.order` answers on a zero margin
+    #: what :func:`~rgbd_eval.methods.cielniak2010.occlusion.order` answers on a zero margin
     tie_a_in_front: NDArray[np.bool_]
     #: the share of the occluded person's thermal pixels that is visible
     back_visible: F64
@@ -98,7 +98,7 @@ def train_groups(data: PairFeatures, rounds: int) -> dict[str, OcclusionClassifi
 
 
 def decisions(clf: OcclusionClassifier, data: PairFeatures) -> NDArray[np.bool_]:
-    """What :func:`~rgbd_eval.track.occlusion.order` answers for ``(a, b)`` of every pair."""
+    """What :func:`~rgbd_eval.methods.cielniak2010.occlusion.order` answers for ``(a, b)`` of every pair."""
     s = clf.model.score(np.concatenate([data.x, -data.x]))
     n = len(data)
     margin = s[:n] - s[n:]

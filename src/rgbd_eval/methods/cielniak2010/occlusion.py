@@ -81,7 +81,7 @@ GROUPS: dict[str, tuple[int, ...]] = {
     "both": tuple(range(len(FEATURES))),
 }
 #: The shipped classifiers (``tools/train_occlusion.py`` writes it).
-MODEL_PATH = Path(__file__).resolve().parent.parent / "data" / "cielniak2010_occlusion.json"
+MODEL_PATH = Path(__file__).resolve().parent / "occlusion.json"
 #: Half-width of the band along a box side, as a share of the box width (at least 1 px).
 _EDGE_BAND = 0.06
 _LUMA = np.array([0.299, 0.587, 0.114])

@@ -11,7 +11,7 @@ Per frame:
 1. Each tracking filter (:mod:`rgbd_eval.track.thermal_pf`) is predicted and weighed by
    the log-likelihood ``score / score_scale + log p(height)``: the silhouette's thermal
    contrast (:mod:`rgbd_eval.track.silhouette`, K) and the plausibility of the standing
-   height the silhouette implies on the floor (:mod:`rgbd_eval.track.person_geometry`,
+   height the silhouette implies on the floor (:mod:`rgbd_eval.methods.cielniak2010.person_geometry`,
    our addition), minus the distance of the colour moments of its head, torso and legs
    to the person's adaptive colour model over ``colour_scale`` (section 4; the colour
    image is aligned by the affine map below), with the interaction ``rho`` towards the
@@ -21,7 +21,7 @@ Per frame:
    against the image noise (:func:`rgbd_eval.track.colour_moments.reliability`): about 1
    in the light, about 0 in the dark, where colour would otherwise mislead. A filter
    behind another one (section 6: pairwise
-   :func:`rgbd_eval.track.occlusion.order`, overlap of the boxes at least
+   :func:`rgbd_eval.methods.cielniak2010.occlusion.order`, overlap of the boxes at least
    ``occlusion_overlap``) coasts on its motion model, and neither penalises nor is
    penalised by the others, for at most ``max_occluded_frames``.
 2. A filter whose estimate scores below ``stop_score`` for ``lost_frames`` frames in a
@@ -30,7 +30,7 @@ Per frame:
    seen clearly (score at least ``start_score``, its box overlapping no other filter's)
    adapts at rate ``colour_alpha``.
 3. The sequential detector proposes person-shaped warm regions
-   (:mod:`rgbd_eval.track.warm_regions`) away from the tracked persons; a proposal that
+   (:mod:`rgbd_eval.methods.cielniak2010.warm_regions`) away from the tracked persons; a proposal that
    scores at least ``start_score`` and implies a standing height within the prior's
    range, and is seen again (IoU >= 0.3) in ``confirm_frames`` consecutive frames,
    starts a filter, with the id of the nearest remembered person whose colour moments lie
@@ -57,6 +57,13 @@ from numpy.typing import NDArray
 from pydantic import Field, model_validator
 
 from rgbd_eval.config import ComponentConfig
+from rgbd_eval.methods.cielniak2010.occlusion import order, overlap
+from rgbd_eval.methods.cielniak2010.person_geometry import (
+    HeightPrior,
+    height_log_prior,
+    implied_heights,
+)
+from rgbd_eval.methods.cielniak2010.warm_regions import WarmRegionParams, WarmRegions, warm_regions
 from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
 from rgbd_eval.track.colour_moments import (
     ColourModel,
@@ -66,8 +73,6 @@ from rgbd_eval.track.colour_moments import (
     person_moments_many,
     reliability,
 )
-from rgbd_eval.track.occlusion import order, overlap
-from rgbd_eval.track.person_geometry import HeightPrior, height_log_prior, implied_heights
 from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores, state_boxes
 from rgbd_eval.track.thermal_pf import (
     F64,
@@ -76,7 +81,6 @@ from rgbd_eval.track.thermal_pf import (
     ThermalParticleFilter,
     box_iou,
 )
-from rgbd_eval.track.warm_regions import WarmRegionParams, WarmRegions, warm_regions
 from rgbd_eval.types import Box2D, Detection, Frame, Stream, TrackOutput, Visibility
 
 _ZERO_C_K = 273.15
@@ -89,7 +93,7 @@ _OWN_COMPONENT = 0.5
 
 
 class Cielniak2010TrackerConfig(ComponentConfig):
-    """Tracker settings; every value and its source is in ``configs/methods/cielniak2010.yaml``."""
+    """Tracker settings; every value and its source is in ``methods/cielniak2010/method.yaml``."""
 
     name: Literal["cielniak2010"] = "cielniak2010"
     n_particles: int = Field(200, ge=10, le=100_000)

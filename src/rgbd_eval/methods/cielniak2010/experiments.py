@@ -3,7 +3,7 @@
 - The data: the share of person instances occluded by another person, per scenario, from
   the ground truth, beside the paper's 1289 of 10,256 (about 13%).
 - The tracker ablation of issue 16: thermal only, plus the colour model, plus occlusion
-  handling (``ablations`` in ``configs/papers/cielniak2010.yaml``), on every scenario for
+  handling (``ablations`` in ``methods/cielniak2010/paper.yaml``), on every scenario for
   several particle-filter seeds; counts are summed over the scenarios per seed, the ratios
   derived, then mean and spread (min .. max) over the seeds.
 - The occlusion classifier per feature group (section 5) on held-out rendered pairs, in
@@ -47,7 +47,7 @@ class Claim:
 
 
 def paper_values(path: Path | None = None) -> dict[str, Any]:
-    """The seed's facts, the ablation and the claim thresholds (``configs/papers/cielniak2010.yaml``)."""
+    """The seed's facts, the ablation and the claim thresholds (``methods/cielniak2010/paper.yaml``)."""
     required = ("dataset", "scenarios", "ablations", "seeds", "classifier", "claims")
     return load_paper("cielniak2010", present=required, path=path)
 
@@ -152,8 +152,8 @@ def summarise_ablation(
 
 def classifier_groups(classifier: Mapping[str, Any]) -> dict[str, dict[str, Any]]:
     """Held-out accuracy per feature group of the shipped classifiers, in light and darkness."""
-    from rgbd_eval.experiments.occlusion_training import evaluate, render_features
-    from rgbd_eval.track.occlusion import load_classifiers
+    from rgbd_eval.methods.cielniak2010.occlusion import load_classifiers
+    from rgbd_eval.methods.cielniak2010.occlusion_training import evaluate, render_features
 
     models = load_classifiers()
     seed, pairs, jitter = (
