@@ -121,7 +121,7 @@ def test_a_missing_switch_counts_as_off() -> None:
 
 def test_html_page_reads_the_paper_file() -> None:
     from rgbd_eval.plugins import ReproduceResult
-    from rgbd_eval.report_html import reproduce_page
+    from rgbd_eval.report.html.pages import reproduce_page
 
     claim = {"sentence": "s", "source": "section 7", "evidence": "e", "held": True}
     result = ReproduceResult(markdown="# x\n", data={"claims": [claim]}, claims=(("s", True),))

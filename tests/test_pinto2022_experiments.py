@@ -8,8 +8,7 @@ from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
 from rgbd_eval.methods.pinto2022.experiments import check_claims, render, trinet_to_units
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.report_html import reproduce_page
-from rgbd_eval.report_html.pages import paper_file
+from rgbd_eval.report.html.pages import paper_file, reproduce_page
 from rgbd_eval.sim import load_scenario
 
 

@@ -8,9 +8,9 @@ named by a string (``importlib.import_module``, ``"module:function"`` references
 plug-in registry) is not an edge: that is discovery by name, like an entry point, and is
 listed apart.
 
-The layer order is ``LAYERS`` in ``tests/test_layers.py`` (lowest first; the first pattern
-that matches a module places it). An edge runs *up* when it goes from a lower layer to a
-higher one. Circles are the strongly connected components of more than one module.
+The layer order is ``LAYERS`` in ``tests/test_layers.py`` (lowest first; the most specific
+pattern that matches a module places it). An edge runs *up* when it goes from a lower layer
+to a higher one. Circles are the strongly connected components of more than one module.
 
 Usage::
 
@@ -218,11 +218,14 @@ def circles(successors: Mapping[str, set[str]]) -> list[list[str]]:
 
 
 def layer_of(module: str, layers: Layers) -> int | None:
-    """The index of the first layer with a pattern matching ``module`` (None: unplaced)."""
+    """The layer of ``module``: that of the most specific (longest) pattern matching it,
+    e.g. ``rgbd_eval.methods.*.experiments`` before ``rgbd_eval.methods.*`` (None: unplaced)."""
+    best: tuple[int, int] | None = None
     for i, (_, patterns) in enumerate(layers):
-        if any(fnmatch.fnmatchcase(module, p) for p in patterns):
-            return i
-    return None
+        for p in patterns:
+            if fnmatch.fnmatchcase(module, p) and (best is None or len(p) > best[0]):
+                best = (len(p), i)
+    return None if best is None else best[1]
 
 
 def up_edges(graph: Graph, layers: Layers) -> list[Edge]:

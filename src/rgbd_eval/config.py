@@ -3,7 +3,7 @@
 A run is configured by one :class:`RunConfig`: the method, how recordings are read,
 the detector's and the tracker's config models (registered by name, see
 :mod:`rgbd_eval.plugins`) and the scoring. Each method's defaults are its paper's
-published parameters, restated in ``configs/methods/<method>.yaml``. Overrides use
+published parameters, restated in its package's ``methods/<method>/method.yaml``. Overrides use
 dotted keys::
 
     tracker.min_confidence=-1.0     detector.voxel_size=0.08     io.max_sync_gap_ms=20

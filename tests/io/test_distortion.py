@@ -18,7 +18,7 @@ from rgbd_eval.io.decode import camera_model_from_info
 from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import Container, RecordingWriter
 from rgbd_eval.pipeline import run_sequence
-from rgbd_eval.report import sequence_record
+from rgbd_eval.report.run import sequence_record
 from rgbd_eval.types import CameraModel
 
 from .conftest import PERIOD, T0

@@ -20,14 +20,14 @@ from rgbd_eval.methods.basso2012.experiments import Claim, Reproduction, to_json
 from rgbd_eval.metrics import Counts
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.report import report_dict
-from rgbd_eval.report_html import (
+from rgbd_eval.report.html.pages import (
     bench_page,
     compare_page,
     reproduce_page,
     write_run_html,
     write_sweep_html,
 )
+from rgbd_eval.report.run import report_dict
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import SweepRecord, SweepResult
 

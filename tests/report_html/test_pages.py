@@ -168,7 +168,7 @@ def test_reproduce_page_shows_paper_beside_measured_and_claims(pages: dict[str, 
 
 def test_config_diff_lists_only_what_differs_from_the_method_defaults() -> None:
     from rgbd_eval.config import load_config
-    from rgbd_eval.report_html.pages import config_diff
+    from rgbd_eval.report.html.pages import config_diff
 
     assert config_diff(load_config(method="basso2012")) == []
     changed = load_config(None, ["tracker.min_confidence=-1.0"], method="basso2012")
@@ -213,7 +213,7 @@ def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidenc
     # finds its source and evidence in the JSON data.
     from rgbd_eval.methods.basso2012.experiments import Claim, Reproduction, to_json
     from rgbd_eval.plugins import ReproduceResult
-    from rgbd_eval.report_html.pages import _claims
+    from rgbd_eval.report.html.pages import _claims
 
     res = Reproduction()
     res.claims = [

@@ -52,7 +52,7 @@ def reproduce(
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.cache import DetectionCache
     from rgbd_eval.engine import connect, parse_cluster
-    from rgbd_eval.report_html import reproduce_page
+    from rgbd_eval.report.html.pages import reproduce_page
     from rgbd_eval.sim.synth import ensure_scenario
     from rgbd_eval.sweep import warm_up
 

@@ -77,7 +77,7 @@ def ensure_demo() -> Path:
 
 
 def print_table(results: list[SequenceResult], config: RunConfig) -> None:
-    from rgbd_eval.report import run_notes, table_header, table_rows
+    from rgbd_eval.report.run import run_notes, table_header, table_rows
 
     scored = [r for r in results if r.scores is not None]
     if scored:
@@ -133,8 +133,8 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
-    from rgbd_eval.report import REPORT_FILE, sequence_warnings, write_run
-    from rgbd_eval.report_html import write_run_html
+    from rgbd_eval.report.html.pages import write_run_html
+    from rgbd_eval.report.run import REPORT_FILE, sequence_warnings, write_run
 
     sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:

@@ -70,8 +70,8 @@ def score(
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
-    from rgbd_eval.report_html import write_score_html
-    from rgbd_eval.scoring import score_sequence, table_rows, write_report
+    from rgbd_eval.report.html.pages import write_score_html
+    from rgbd_eval.report.scoring import score_sequence, table_rows, write_report
 
     sets = list(overrides or [])
     for key, value in (("gating", gating), ("convention", convention)):
@@ -115,7 +115,7 @@ def score(
     if json_out:
         typer.echo(json.dumps(report, indent=2))
         return
-    from rgbd_eval.report import table_header
+    from rgbd_eval.report.run import table_header
 
     ev = config.evaluation
     title = (

@@ -56,7 +56,7 @@ def _write_outputs(
 ) -> None:
     """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
     folder, then publish."""
-    from rgbd_eval.report_html import write_sweep_html
+    from rgbd_eval.report.html.pages import write_sweep_html
 
     tmp = folder.staging
     rows = result.rows()
@@ -141,7 +141,7 @@ def sweep(
     from rgbd_eval.config import load_config
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
-    from rgbd_eval.report import format_value
+    from rgbd_eval.report.run import format_value
     from rgbd_eval.sweep import (
         SweepParam,
         expand_grid,

@@ -14,8 +14,8 @@ from numpy.typing import NDArray
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import OutputError
 from rgbd_eval.pipeline import SequenceResult
-from rgbd_eval.report_html.events import frame_errors
-from rgbd_eval.report_html.overlay import draw_frame, rgb_frames
+from rgbd_eval.report.html.events import frame_errors
+from rgbd_eval.report.html.overlay import draw_frame, rgb_frames
 
 #: OpenCV's MPEG-4 Part 2 encoder, the one opencv-python-headless wheels ship for .mp4.
 FOURCC = "mp4v"

@@ -21,19 +21,19 @@ from rgbd_eval.compare import flatten
 from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
 from rgbd_eval.metrics import SequenceScores, Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
-from rgbd_eval.report import COLUMNS, format_value, run_notes, table_header, table_rows
-from rgbd_eval.report_html import plots
-from rgbd_eval.report_html.events import busiest_frames, frame_errors, markers, worst_frames
-from rgbd_eval.report_html.overlay import drawn_tracks, rgb_frames
-from rgbd_eval.report_html.render import data_uri, jpeg_uri, render
-from rgbd_eval.report_html.video import Progress, overlay, write_overlay_video
+from rgbd_eval.report.html import plots
+from rgbd_eval.report.html.events import busiest_frames, frame_errors, markers, worst_frames
+from rgbd_eval.report.html.overlay import drawn_tracks, rgb_frames
+from rgbd_eval.report.html.render import data_uri, jpeg_uri, render
+from rgbd_eval.report.html.video import Progress, overlay, write_overlay_video
+from rgbd_eval.report.run import COLUMNS, format_value, run_notes, table_header, table_rows
 from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
     from rgbd_eval.compare import Comparison
     from rgbd_eval.plugins import ReproduceResult
-    from rgbd_eval.scoring import ScoredSequence
+    from rgbd_eval.report.scoring import ScoredSequence
     from rgbd_eval.sweep import Point, SweepResult
 
 #: Frames in the worst-frame strip of each sequence.
@@ -218,7 +218,7 @@ def write_score_html(
     There is no recording to draw on; the bird's-eye plot is drawn where the
     ground truth has world positions.
     """
-    from rgbd_eval.scoring import table_rows as score_rows
+    from rgbd_eval.report.scoring import table_rows as score_rows
 
     sections = []
     for s in sequences:

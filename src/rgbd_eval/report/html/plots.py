@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from rgbd_eval.report_html.events import FrameErrors, Marker, MarkerKind
-from rgbd_eval.report_html.overlay import track_colour
-from rgbd_eval.report_html.render import figure_png, pyplot
+from rgbd_eval.report.html.events import FrameErrors, Marker, MarkerKind
+from rgbd_eval.report.html.overlay import track_colour
+from rgbd_eval.report.html.render import figure_png, pyplot
 from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 DPI = 100

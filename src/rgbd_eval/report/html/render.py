@@ -1,6 +1,6 @@
 """Template rendering and inline images: every page is one self-contained file.
 
-Pages are rendered from the Jinja2 templates shipped in ``rgbd_eval/templates``
+Pages are rendered from the Jinja2 templates shipped in ``rgbd_eval/report/templates``
 (autoescaped); images are embedded as ``data:`` URIs (plots as PNG, camera frames
 as JPEG, which is a tenth of the size for photographs), so a page opens offline.
 """
@@ -29,7 +29,7 @@ JPEG_QUALITY = 85
 def environment() -> jinja2.Environment:
     """The template environment (templates from the installed package, autoescaped)."""
     env = jinja2.Environment(
-        loader=jinja2.PackageLoader("rgbd_eval", "templates"),
+        loader=jinja2.PackageLoader("rgbd_eval.report", "templates"),
         autoescape=True,
         undefined=jinja2.StrictUndefined,
         trim_blocks=True,

@@ -22,7 +22,7 @@ from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
 from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
 from rgbd_eval.outdir import OutputFolder
-from rgbd_eval.report import (
+from rgbd_eval.report.run import (
     COLUMNS,
     MATCHING,
     REPORT_SCHEMA_VERSION,
@@ -157,7 +157,7 @@ def write_report(
 
     ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder.
     """
-    from rgbd_eval.report import table_header
+    from rgbd_eval.report.run import table_header
 
     report = report_dict(sequences, config, max_gap_ns)
     header = table_header()
