@@ -9,7 +9,8 @@ Exit codes (also in README.md):
 ====  =====================================================================
 0     success (scored, or nothing to score and the report says so)
 1     ``compare``: a metric regressed beyond its tolerance
-2     command-line usage error; ``compare``: unusable reports
+2     command-line usage error; ``compare``: unusable reports; an optional dependency
+      missing (``run --rerun``, ``view``: the Rerun SDK)
 3     bad input recording (missing, truncated, wrong content)
 4     bad configuration (unknown key, wrong type, value out of range)
 5     bad ground truth (missing, unreadable, contradictory)
@@ -70,6 +71,12 @@ class SyncError(InputError):
 
 class TransformError(InputError):
     """The tf chain from the world frame to the camera is broken."""
+
+
+class ExtraError(RgbdEvalError):
+    """A feature needs an optional dependency (a pip extra) that is not installed."""
+
+    exit_code = 2
 
 
 class ConfigError(RgbdEvalError):

@@ -15,8 +15,9 @@ from rgbd_eval.cli.main import app
 
 ROOT = Path(__file__).resolve().parents[2]
 OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
-#: Flags that belong to other programs quoted in the README (pip, pytest, dask).
+#: Flags that belong to other programs quoted in the README (pip, pytest, dask, rerun, chromium).
 FOREIGN = {"--no-deps", "--upgrade", "--strict-markers", "--nworkers", "--nthreads"}
+FOREIGN |= {"--headless", "--web-viewer", "--use-angle", "--enable-unsafe-swiftshader"}
 
 
 def _options() -> dict[str, set[str]]:
@@ -24,6 +25,8 @@ def _options() -> dict[str, set[str]]:
     out = {"": {"--version", "--help"}}
     for name, command in group.commands.items():  # type: ignore[attr-defined]
         out[name] = {opt for p in command.params for opt in p.opts} | {"--help"}
+        for sub, subcommand in getattr(command, "commands", {}).items():  # `annotate export`
+            out[f"{name} {sub}"] = {opt for p in subcommand.params for opt in p.opts} | {"--help"}
     return out
 
 
@@ -33,8 +36,9 @@ def test_readme_examples_use_existing_options() -> None:
     for line in (ROOT / "README.md").read_text().splitlines():
         words = line.strip().split()
         if len(words) > 1 and words[0] == "rgbd-eval" and words[1] in options:
+            command = " ".join(words[1:3]) if " ".join(words[1:3]) in options else words[1]
             for flag in OPTION.findall(line.split("#")[0]):
-                assert flag in options[words[1]], f"README: `{line.strip()}`: {flag} unknown"
+                assert flag in options[command], f"README: `{line.strip()}`: {flag} unknown"
     for flag in set(OPTION.findall((ROOT / "README.md").read_text())) - FOREIGN:
         assert flag in everything, f"README names {flag}, which no command accepts"
 

@@ -1635,6 +1635,78 @@ def _import_cases() -> list[Case]:
     ]
 
 
+def _annotate_and_view_cases() -> list[Case]:
+    """CVAT exports that are not, or not of this recording; runs `view` cannot show (issue 34)."""
+
+    def cvat(box: str = 'xtl="2.00" ytl="3.00" xbr="12.00" ybr="40.00"', size: int = FRAMES) -> str:
+        return (
+            '<?xml version="1.0" encoding="utf-8"?>\n<annotations><version>1.1</version>'
+            f"<meta><task><size>{size}</size><original_size><width>64</width><height>48"
+            '</height></original_size></task></meta><track id="0" label="person">'
+            f'<box frame="0" outside="0" occluded="0" keyframe="1" {box} z_order="0"/>'
+            "</track></annotations>\n"
+        )
+
+    def importing(name: str, text: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            (root / name).write_text(text)
+            rec, out = good_recording(root), str(root / "imported.gt.csv")
+            return ["annotate", "import", str(root / name), "--recording", str(rec), "-o", out]
+
+        return build
+
+    def view_score_report(root: Path) -> list[str]:
+        (root / "score").mkdir()
+        (root / "score" / "report.json").write_text('{"config": {}, "sequences": [{"name": "x"}]}')
+        return ["view", str(root / "score")]
+
+    def export_to_file(root: Path) -> list[str]:
+        (root / "task").write_text("mine")
+        return ["annotate", "export", str(good_recording(root)), "-o", str(root / "task")]
+
+    return [
+        Case(
+            "cvat_box_outside",
+            "TRACEBACK",
+            importing("a.xml", cvat('xtl="50" ytl="3" xbr="90" ybr="40"')),
+            5,
+            "reaches outside the 64x48 image",
+        ),
+        Case(
+            "cvat_other_task_size",
+            "SILENT",
+            importing("a.xml", cvat(size=9)),
+            5,
+            "which no --every gives",
+        ),
+        Case(
+            "cvat_not_xml",
+            "TRACEBACK",
+            importing("a.xml", "<annotations><version>"),
+            5,
+            "not well-formed",
+        ),
+        Case(
+            "cvat_mot_without_every",
+            "WRONG-CODE",
+            importing("gt.txt", "1,1,2,3,10,37,1,1,1\n"),
+            4,
+            "give --every",
+        ),
+        Case(
+            "view_no_report",
+            "TRACEBACK",
+            lambda root: ["view", str(root)],
+            3,
+            "holds no report.json",
+        ),
+        Case(
+            "view_score_report", "TRACEBACK", view_score_report, 3, "written by `rgbd-eval score`"
+        ),
+        Case("annotate_export_to_a_file", "TRACEBACK", export_to_file, 7, "not a folder"),
+    ]
+
+
 def all_cases() -> list[Case]:
     """Every case of the corpus."""
     return [
@@ -1656,6 +1728,7 @@ def all_cases() -> list[Case]:
         *_nesting_and_size_cases(),
         *_recording_value_cases(),
         *_import_cases(),
+        *_annotate_and_view_cases(),
     ]
 
 

@@ -14,6 +14,7 @@ except ImportError:  # pragma: no cover - depends on the installed typer
     from click import ClickException  # type: ignore[assignment,unused-ignore]
 
 from rgbd_eval import __version__
+from rgbd_eval.cli.annotate_cmd import annotate
 from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.cli.common import Interrupted, interrupted_line, interruption, one_line
 from rgbd_eval.cli.compare_cmd import compare
@@ -25,6 +26,7 @@ from rgbd_eval.cli.run import run
 from rgbd_eval.cli.score_cmd import score
 from rgbd_eval.cli.sweep_cmd import sweep
 from rgbd_eval.cli.synth_cmd import synth
+from rgbd_eval.cli.view_cmd import view
 
 app = typer.Typer(
     name="rgbd-eval",
@@ -44,6 +46,8 @@ app.command("bench")(bench)
 app.command("score")(score)
 app.command("methods")(methods)
 app.command("import")(import_)
+app.add_typer(annotate)
+app.command("view")(view)
 
 
 def _version(value: bool) -> None:

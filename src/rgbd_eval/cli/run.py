@@ -130,6 +130,14 @@ def run(
         str | None,
         typer.Option(help=f"{CLUSTER_HELP} (default: in this process for one recording)"),
     ] = None,
+    rerun: Annotated[
+        Path | None,
+        typer.Option(
+            "--rerun",
+            help="also write the run as a Rerun recording (FILE.rrd; one recording; "
+            "needs pip install 'rgbd-eval[rerun]')",
+        ),
+    ] = None,
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
@@ -149,6 +157,16 @@ def run(
         raise GroundTruthError(
             gt, "--gt applies to a single recording; use <name>.gt.csv sidecars for several"
         )
+    rrd = None
+    if rerun is not None:  # checked before any work, like the output folder
+        from rgbd_eval.rerun_log import RrdOutput
+
+        if len(recordings) > 1:
+            raise typer.BadParameter(
+                "takes one recording; for several, `rgbd-eval view` writes each run's",
+                param_hint="'--rerun'",
+            )
+        rrd = RrdOutput(rerun, "run", recordings)
     out_dir = out or Path("runs") / f"{time.strftime('%Y%m%d-%H%M%S')}-{config.method}"
     results: list[SequenceResult] = []
     # What this run will write, checked against what the folder holds before any work.
@@ -185,6 +203,10 @@ def run(
                     staging, results, config, rep, video, advance_callback(bar, task)
                 ),
             )
+    if rrd is not None:  # re-reads the recording for its images and depth, as --video does
+        with progress_bar() as bar:
+            task = bar.add_task(rrd.path.name, total=None)
+            rrd.write(results[0], config, advance_callback(bar, task))
     if json_out:
         typer.echo(json.dumps(report, indent=2))
     else:
@@ -193,6 +215,8 @@ def run(
             f"report: {out_dir / 'report.html'}, {out_dir / 'report.md'} "
             f"(machine-readable: {out_dir / 'report.json'})"
         )
+        if rrd is not None:
+            console.print(f"Rerun: rerun {rrd.path}")
     for r in results:  # also in report.json: each sequence's "warnings"
         for w in sequence_warnings(r):
             err_console.print(
