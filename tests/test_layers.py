@@ -86,6 +86,7 @@ LAYERS = [
             "rgbd_eval.engine",
             "rgbd_eval.sweep",
             "rgbd_eval.bench",
+            "rgbd_eval.annotate",
         ],
     ),
     ("experiments of reproduce", ["rgbd_eval.methods.*.experiments"]),

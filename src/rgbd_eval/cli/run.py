@@ -159,7 +159,7 @@ def run(
         )
     rrd = None
     if rerun is not None:  # checked before any work, like the output folder
-        from rgbd_eval.rerun_log import RrdOutput
+        from rgbd_eval.report.rerun import RrdOutput
 
         if len(recordings) > 1:
             raise typer.BadParameter(

@@ -210,10 +210,10 @@ def _per_frame(
 
 def _sequence_view(folder: Path, record: dict[str, Any], config: RunConfig, method: str) -> RunView:
     """One sequence of a run folder, checked against its recording (present, unchanged)."""
+    from rgbd_eval.files import file_digest
     from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
     from rgbd_eval.io.tracks import read_tracks_csv
     from rgbd_eval.pipeline import match_ground_truth, open_for
-    from rgbd_eval.report import file_digest
 
     name, path = str(record["name"]), Path(str(record["path"]))
     if not path.exists():
@@ -382,7 +382,7 @@ class _Logger:
     """Logs one sequence frame by frame into a recording stream."""
 
     def __init__(self, rr: Any, stream: rr.RecordingStream, view: RunView) -> None:
-        from rgbd_eval.report_html.overlay import GT_COLOUR, MISS_COLOUR, track_colour
+        from rgbd_eval.report.html.overlay import GT_COLOUR, MISS_COLOUR, track_colour
 
         self.rr = rr
         self.rec = stream
