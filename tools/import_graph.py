@@ -61,7 +61,7 @@ class Graph:
 
 
 def module_name(path: Path, src: Path) -> str:
-    """``src/rgbd_eval/io/reader.py`` -> ``rgbd_eval.io.reader`` (a package is its folder)."""
+    """``src/rgbd_eval/io/recording.py`` -> ``rgbd_eval.io.recording`` (a package is its folder)."""
     parts = path.relative_to(src).with_suffix("").parts
     if parts[-1] == "__init__":
         parts = parts[:-1]

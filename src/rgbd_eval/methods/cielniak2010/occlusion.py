@@ -31,7 +31,7 @@ Every feature is antisymmetric, ``f(b, a) = -f(a, b)``, and the decision is
 cannot be measured (no colour image, ``a`` wholly inside ``b``) is 0, which adds the same
 vote to both scores and so drops out.
 
-The tracker's interface (``track/cielniak2010.py``): ``order(a, b, thermal, colour,
+The tracker's interface (``tracker.py``): ``order(a, b, thermal, colour,
 affine) -> 0 | 1`` (0: ``a`` is in front), ``sort_front_to_back(boxes, thermal, colour,
 affine)`` and ``overlap(a, b)``; they build the :class:`OcclusionScene` once per frame.
 """
@@ -370,7 +370,7 @@ def depth_order(
 
 
 # ----------------------------------------------------------------------------- tracker interface
-# The interface agreed with the tracker (track/cielniak2010.py): images in, the scene built
+# The interface agreed with the tracker (tracker.py): images in, the scene built
 # once per frame (the last one is kept while the tracker passes the same image objects).
 
 _last: list[tuple[object, object, object, OcclusionScene]] = []
