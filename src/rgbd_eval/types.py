@@ -650,6 +650,19 @@ class TrackOutput:
 
 
 @dataclass(frozen=True)
+class TrackerOutput:
+    """Tracker output of one sequence: (frame, stamp_ns, tracks) sorted by stamp, then frame."""
+
+    source: str
+    frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
+    num_frames: int | None = None
+    """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
+    sensor_poses: tuple[Pose | None, ...] = ()
+    """Per frame, the world pose of the frame the tracks were published in (a recording's
+    tf), None where unknown; empty when the source has none (text files)."""
+
+
+@dataclass(frozen=True)
 class GroundTruthObject:
     """One annotated person in one frame.
 

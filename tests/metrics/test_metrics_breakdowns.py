@@ -270,9 +270,9 @@ def test_a_run_is_analysed_on_its_annotated_span_only() -> None:
     """
     from types import SimpleNamespace
 
-    from rgbd_eval.analysis import analyse, inputs_of_run
     from rgbd_eval.config import RunConfig
     from rgbd_eval.pipeline import GroundTruthMatch, score_sequence
+    from rgbd_eval.report.analysis import analyse, inputs_of_run
 
     n, span = 8, (2, 5)
     gts = [[gt(1, None, (1.0, 0.0), frame=f)] if 2 <= f <= 5 else [] for f in range(n)]

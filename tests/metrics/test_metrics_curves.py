@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from rgbd_eval.cli.main import app
 from rgbd_eval.config import EvaluationConfig
 from rgbd_eval.metrics import curves
-from rgbd_eval.scoring import score_sequence
+from rgbd_eval.report.scoring import score_sequence
 
 TUD = Path(pytest.importorskip("motmetrics").__file__).parent / "data"
 

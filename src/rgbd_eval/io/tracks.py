@@ -50,7 +50,14 @@ from rgbd_eval.io.groundtruth import (
     require_objects,
 )
 from rgbd_eval.io.validate import MAX_FRAME, MAX_PIXELS, position_problem
-from rgbd_eval.types import Box2D, GroundTruthObject, Pose, TrackOutput, Visibility
+from rgbd_eval.types import (
+    Box2D,
+    GroundTruthObject,
+    Pose,
+    TrackerOutput,
+    TrackOutput,
+    Visibility,
+)
 
 
 class Benchmark(enum.Enum):
@@ -71,19 +78,6 @@ _DISTRACTORS = {
     Benchmark.MOT17: frozenset({2, 7, 8, 12}),
     Benchmark.MOT20: frozenset({2, 6, 7, 8, 12}),
 }
-
-
-@dataclass(frozen=True)
-class TrackerOutput:
-    """Tracker output of one sequence: (frame, stamp_ns, tracks) sorted by stamp, then frame."""
-
-    source: str
-    frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
-    num_frames: int | None = None
-    """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
-    sensor_poses: tuple[Pose | None, ...] = ()
-    """Per frame, the world pose of the frame the tracks were published in (a recording's
-    tf), None where unknown; empty when the source has none (text files)."""
 
 
 @dataclass(frozen=True)
