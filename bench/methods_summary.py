@@ -4,7 +4,8 @@ decode floor, their ratio, and whether the method reaches 60 fps (issue 32's tar
     .venv/bin/python -m bench.methods_summary runs/bench/method_*.json
 
 The CPU fps is what an idle core gives (the process's user + system time per frame);
-the ratio is the pipeline's CPU time per frame over the decode floor's time per frame.
+the ratio is the pipeline's CPU time per frame over the decode floor's time per frame
+(the floor is wall time: on a loaded machine it grows, and the ratio reads low).
 The machine (CPU model) comes from the JSON (schema 3).
 """
 
@@ -30,11 +31,13 @@ def main(paths: list[str]) -> None:
         dw, dh = data["depth_size"]
         rw, rh = data["rgb_size"]
         fps = 1e3 / cpu_ms if cpu_ms > 0 else float("inf")
+        sizes = [f"RGB {rw}x{rh}"] if rw else []
+        sizes += [f"depth {dw}x{dh}"] if dw else []
         rows.append(
             (
-                data["method"],
+                data["method"].split(" (")[0],  # "basso2012 (basso2012 + basso2012)"
                 Path(data["path"]).name,
-                f"{rw}x{rh}" + (f" / depth {dw}x{dh}" if dw else ""),
+                ", ".join(sizes) or "other streams",
                 data["frames"],
                 fps,
                 data["floor_fps"],
