@@ -49,7 +49,11 @@ run: $(STAMP) $(DEMO)
 
 # One-core figures (the bench pins itself to one CPU): the demo, one thesis scenario, the
 # demo with depth at 320x240, and with raw RGB in .mcap and .bag (decode floor for raw
-# images), and pinto2022 on the demo (seed 001 V-C1: 33 Hz with a GPU). JSON under runs/bench/.
+# images); then each of the five methods on its own demo-sized recording (basso2012 and
+# pinto2022 on the demo, 160x120 depth; satake2009 on its stereo pair at 512x384;
+# cielniak2010 and dmtbs on the first 150 frames of a scenario of theirs) and a summary:
+# CPU fps on one core, the decode floor, their ratio, below 60 fps. JSON under runs/bench/.
+BENCH_SYNTH := $(BIN)/rgbd-eval synth --frames 150
 bench: $(STAMP) $(DEMO)
 	@mkdir -p runs/bench
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 3 --json > runs/bench/demo.json
@@ -63,6 +67,15 @@ bench: $(STAMP) $(DEMO)
 	$(BIN)/rgbd-eval bench runs/bench/demo_raw.bag --repeat 3 --json > runs/bench/demo_raw_bag.json
 	$(BIN)/rgbd-eval bench $(DEMO) --method pinto2022 --repeat 1 --json > runs/bench/demo_pinto2022.json
 	$(BIN)/rgbd-eval bench $(DEMO) --repeat 1
+	@test -f runs/bench/satake2009.mcap || $(BENCH_SYNTH) configs/scenarios/satake2009_crossing.yaml -o runs/bench/satake2009.mcap
+	@test -f runs/bench/cielniak2010.mcap || $(BENCH_SYNTH) configs/scenarios/cielniak2010/thermal_corridor.yaml -o runs/bench/cielniak2010.mcap
+	@test -f runs/bench/dmtbs.mcap || $(BENCH_SYNTH) configs/scenarios/dmtbs/scene1.yaml -o runs/bench/dmtbs.mcap
+	$(BIN)/rgbd-eval bench runs/bench/satake2009.mcap --method satake2009 --repeat 3 --json > runs/bench/method_satake2009.json
+	$(BIN)/rgbd-eval bench runs/bench/cielniak2010.mcap --method cielniak2010 --repeat 3 --json > runs/bench/method_cielniak2010.json
+	$(BIN)/rgbd-eval bench runs/bench/dmtbs.mcap --method dmtbs --repeat 3 --json > runs/bench/method_dmtbs.json
+	cp runs/bench/demo.json runs/bench/method_basso2012.json
+	cp runs/bench/demo_pinto2022.json runs/bench/method_pinto2022.json
+	$(BIN)/python -m bench.methods_summary runs/bench/method_*.json
 
 test: $(STAMP) test-deps
 	$(BIN)/python -m pytest -q -n 2

@@ -19,6 +19,7 @@ from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.errors import ConfigError, InputError
+from rgbd_eval.machine import machine_info
 from rgbd_eval.methods.basso2012.detector import STAGES
 from rgbd_eval.sim import load_scenario, synthesize
 
@@ -100,6 +101,7 @@ def test_json_is_versioned_and_complete(result: BenchResult) -> None:
     assert data["stage_ms"] == result.stage_ms
     for key in ("floor_fps", "ratio", "raw_ms", "peak_rss_mib", "frames", "method"):
         assert key in data
+    assert data["machine"] == machine_info() and set(data["machine"]) == {"cpu", "arch", "flags"}
 
 
 def test_bad_arguments_raise_package_errors(recording: Path, tmp_path: Path) -> None:

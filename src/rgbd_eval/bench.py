@@ -29,6 +29,7 @@ from rgbd_eval.components import needs_frame
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import ConfigError, InputError
 from rgbd_eval.io.benchmark import time_read
+from rgbd_eval.machine import machine_info
 from rgbd_eval.pipeline import (
     DETECT_REST,
     TRACK_REST,
@@ -41,7 +42,7 @@ from rgbd_eval.pipeline import (
 )
 from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
 
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3  # 3: machine (CPU model, arch, flags)
 
 #: Stages before and after detection, in pipeline order.
 READ_STAGES = ("index", "decode")
@@ -162,6 +163,7 @@ class BenchResult:
             "cpu_ms": self.cpu_ms,
             "cpu_fps": self.cpu_fps if self.cpu_ms_repeats else None,
             "cpu_ms_repeats": list(self.cpu_ms_repeats),
+            "machine": machine_info(),
         }
 
 

@@ -139,3 +139,41 @@ def test_align_by_stamp_and_by_index() -> None:
     per_frame, unmatched = no_stamps.align([7, 8], max_gap_ns=0)
     assert no_stamps.match([7, 8], max_gap_ns=0)[2] == [1]
     assert [len(p) for p in per_frame] == [0, 1] and unmatched == 0
+
+
+@pytest.mark.parametrize(
+    ("rows", "expected"),
+    [
+        # The first row with a problem is named, whichever check finds it (arrays or objects).
+        (["1,1,0,0,5,5,1,1,1", "1,1,0,0,5,5,1,1,1", "2,2,0,0,0,5,1,1,1"], "id 1 appears twice"),
+        (
+            ["1,1,0,0,5,5,1,1,1", "2,2,0,0,0,5,1,1,1", "3,3,0,0,5,5,1,1,1", "3,3,0,0,5,5,1,1,1"],
+            "frame 1, id 2: box size 0.0x5.0 is empty",
+        ),
+        (["1,1,0,0,5,-0,1,1,1"], "frame 0, id 1: box size 5.0x-0.0 is negative"),
+    ],
+)
+def test_mot_gt_names_first_problem(tmp_path: Path, rows: list[str], expected: str) -> None:
+    from rgbd_eval.io.tracks import read_mot_gt
+
+    path = tmp_path / "gt.txt"
+    path.write_text("\n".join(rows) + "\n")
+    with pytest.raises(GroundTruthError, match=expected):
+        read_mot_gt(path)
+
+
+def test_mot_gt_objects_as_read_row_by_row(tmp_path: Path) -> None:
+    """Classes, consider flags and visibility (clamped, NaN to 0) as the devkit reads them."""
+    from rgbd_eval.io.tracks import read_mot_gt
+
+    path = tmp_path / "gt.txt"
+    path.write_text("1,4,1.5,2,3,4,1,1,1.7\n1,5,0,0,3,4,0,1,nan\n2,4,0,0,3,4,1,7,-0.2\n")
+    frames = read_mot_gt(path).frames
+    assert [(f, [o.object_id for o in objs]) for f, _, objs in frames] == [(0, [4, 5]), (1, [4])]
+    first, second = frames[0][2]
+    assert first.box2d == Box2D(1.5, 2.0, 3.0, 4.0)
+    assert (first.visibility, first.ignore, first.distractor) == (1.0, False, False)
+    assert (second.visibility, second.ignore, second.distractor) == (0.0, True, False)
+    third = frames[1][2][0]
+    assert (third.visibility, third.ignore, third.distractor) == (0.0, True, True)
+    assert str(third.visibility) == "0.0"

@@ -158,14 +158,17 @@ def _group(
     objects: Iterable[GroundTruthObject],
     empty: Iterable[tuple[int, int]] = (),
     first_frame: int = 0,
+    checked: bool = False,
 ) -> GroundTruth:
     """Group objects by frame (indices from 0), rejecting contradictions and values no
     annotation has.
 
     ``empty`` lists ``(frame, stamp_ns)`` of frames annotated with nobody in them;
-    ``first_frame`` is the number the source gave the first frame (kept for reports).
+    ``first_frame`` is the number the source gave the first frame (kept for reports);
+    ``checked``: the caller found :func:`object_problem` None for every object.
     """
     by_frame: dict[int, list[GroundTruthObject]] = {}
+    ids: dict[int, set[int]] = {}
     stamps: dict[int, int] = {}
     for frame, stamp in empty:
         if (problem := frame_problem(frame, stamp)) is not None:
@@ -177,17 +180,18 @@ def _group(
         stamps[frame] = stamp
         by_frame.setdefault(frame, [])
     for o in objects:
-        if (problem := object_problem(o)) is not None:
+        if not checked and (problem := object_problem(o)) is not None:
             raise GroundTruthError(source, f"frame {o.frame}, id {o.object_id}: {problem}")
         if o.frame in stamps and stamps[o.frame] != o.stamp_ns:
             raise GroundTruthError(
                 source, f"frame {o.frame} has two stamps ({stamps[o.frame]} and {o.stamp_ns})"
             )
         stamps[o.frame] = o.stamp_ns
-        group = by_frame.setdefault(o.frame, [])
-        if any(p.object_id == o.object_id for p in group):
+        seen = ids.setdefault(o.frame, set())
+        if o.object_id in seen:
             raise GroundTruthError(source, f"id {o.object_id} appears twice in frame {o.frame}")
-        group.append(o)
+        seen.add(o.object_id)
+        by_frame.setdefault(o.frame, []).append(o)
     order = sorted(by_frame, key=lambda f: (stamps[f], f))
     prev = -1
     for f in order:
@@ -452,13 +456,16 @@ def from_objects(
     objects: Iterable[GroundTruthObject],
     empty: Iterable[tuple[int, int]] = (),
     first_frame: int = 0,
+    checked: bool = False,
 ) -> GroundTruth:
     """Group already decoded objects (frames from 0; e.g. from the ground-truth topic).
 
     ``empty`` lists ``(frame, stamp_ns)`` of frames annotated with nobody in them;
-    ``first_frame`` is the number their source gave the first frame (kept for reports).
+    ``first_frame`` is the number their source gave the first frame (kept for reports);
+    ``checked``: the caller found :func:`object_problem` None for every object (a
+    reader that checks its values as arrays).
     """
-    return _group(source, objects, empty, first_frame)
+    return _group(source, objects, empty, first_frame, checked)
 
 
 def require_objects(gt: GroundTruth) -> GroundTruth:

@@ -199,10 +199,18 @@ def read_mot_tracks(path: Path, text: str | None = None) -> TrackerOutput:
     error = _tracks_error(path)
     rows = _mot_rows(text if text is not None else read_text(path, error, "tracker output"), error)
     by_frame: dict[int, list[TrackOutput]] = {}
-    for line, row in enumerate(rows, start=1):
-        world = row.shape[0] >= 10 and not np.all(row[7:10] == -1)
-        x, y, z = (float(v) for v in row[7:10]) if world else (math.nan,) * 3
-        if row[4] < 0 or row[5] < 0:
+    if not rows.size:
+        return TrackerOutput(str(path), ())
+    # Checked as arrays, then one Python row at a time (plain floats: no numpy scalars).
+    has_world = (
+        ~np.all(rows[:, 7:10] == -1, axis=1) if rows.shape[1] >= 10 else np.zeros(len(rows), bool)
+    )
+    negative = (rows[:, 4] < 0) | (rows[:, 5] < 0)
+    for line, (row, world, neg) in enumerate(
+        zip(rows.tolist(), has_world.tolist(), negative.tolist(), strict=True), start=1
+    ):
+        x, y, z = row[7:10] if world else (math.nan,) * 3
+        if neg:
             raise InputError(path, f"frame {int(row[0])} id {int(row[1])}: negative box size")
         if world and (problem := position_problem((x, y, z))) is not None:
             raise InputError(path, f"row {line}: {problem}")
@@ -212,7 +220,7 @@ def read_mot_tracks(path: Path, text: str | None = None) -> TrackerOutput:
                 x=x,
                 y=y,
                 height=2.0 * z if world else math.nan,
-                box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
+                box2d=Box2D(row[2], row[3], row[4], row[5]),
                 visibility=Visibility.VISIBLE,
                 confidence=float(row[6]) if row.shape[0] >= 7 and math.isfinite(row[6]) else None,
             )
@@ -268,36 +276,51 @@ def read_mot_gt(
     error = _gt_error(path)
     rows = _mot_rows(text if text is not None else read_text(path, error, "ground truth"), error)
     rules = _mot_benchmark(rows, benchmark, error)
-    objects = []
-    for row in rows:
-        frame, oid = int(row[0]) - MOT_FIRST_FRAME, int(row[1])
-        ignore, distractor, visibility = False, True, 1.0
-        world = None
-        if rules is Benchmark.MOT15:
-            if row.shape[0] >= 10 and not np.all(row[7:10] == -1):
-                world = (float(row[7]), float(row[8]), float(row[9]))
-            # TrackEval drops MOT15 rows whose consider flag is 0 (no distractor matching).
-            ignore, distractor = row.shape[0] >= 7 and row[6] == 0, False
-        if rules is not Benchmark.MOT15:
-            cls = int(row[7])
-            scored = cls == _PEDESTRIAN and row[6] != 0
-            ignore = not scored
-            distractor = cls in _DISTRACTORS[rules]
-            if row.shape[0] >= 9:
-                visibility = min(1.0, max(0.0, float(row[8])))
-        objects.append(
-            GroundTruthObject(
-                frame=frame,
-                stamp_ns=0,
-                object_id=oid,
-                box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
-                world_xyz=world,
-                visibility=visibility,
-                ignore=ignore,
-                distractor=distractor,
-            )
+    if not rows.size:
+        return from_objects(str(path), [], first_frame=MOT_FIRST_FRAME)
+    # The devkit's rules as arrays, then the objects from plain Python values.
+    n, columns = rows.shape
+    worlds: list[tuple[float, float, float] | None] = [None] * n
+    visibility = np.ones(n)
+    if rules is Benchmark.MOT15:
+        if columns >= 10:
+            has_world = ~np.all(rows[:, 7:10] == -1, axis=1)
+            for k in np.flatnonzero(has_world).tolist():
+                x, y, z = rows[k, 7:10].tolist()
+                worlds[k] = (x, y, z)
+        # TrackEval drops MOT15 rows whose consider flag is 0 (no distractor matching).
+        ignore = rows[:, 6] == 0 if columns >= 7 else np.zeros(n, bool)
+        distractor = np.zeros(n, bool)
+    else:
+        cls = rows[:, 7].astype(np.int64)
+        ignore = ~((cls == _PEDESTRIAN) & (rows[:, 6] != 0))
+        distractor = np.isin(cls, np.array(sorted(_DISTRACTORS[rules])))
+        if columns >= 9:  # clamped into [0, 1], NaN to 0 (as min(1, max(0, v)))
+            visibility = np.where(np.isnan(rows[:, 8]), 0.0, np.clip(rows[:, 8], 0.0, 1.0)) + 0.0
+    frames = rows[:, 0].astype(np.int64) - MOT_FIRST_FRAME
+    objects = [
+        GroundTruthObject(
+            frame=frame,
+            stamp_ns=0,
+            object_id=oid,
+            box2d=Box2D(left, top, width, height),
+            world_xyz=world,
+            visibility=vis,
+            ignore=ign,
+            distractor=dis,
         )
-    if objects and all(o.ignore for o in objects):
+        for frame, oid, (left, top, width, height), world, vis, ign, dis in zip(
+            frames.tolist(),
+            rows[:, 1].astype(np.int64).tolist(),
+            rows[:, 2:6].tolist(),
+            worlds,
+            visibility.tolist(),
+            ignore.tolist(),
+            distractor.tolist(),
+            strict=True,
+        )
+    ]
+    if ignore.all():
         raise error(
             f"no row is scored under {rules.value} rules (every row is ignored: "
             + (
@@ -306,7 +329,12 @@ def read_mot_gt(
                 else "not a pedestrian, class 1, with the consider flag set)"
             )
         )
-    return from_objects(str(path), objects, first_frame=MOT_FIRST_FRAME)
+    # What object_problem checks that _mot_rows has not: box sizes (-0 too) and positions;
+    # any found, the objects go through it, which names the first as it always did.
+    sizes = rows[:, 4:6]
+    bad = (np.signbit(sizes) | (sizes == 0)).any()
+    bad = bad or any(w is not None and position_problem(w) is not None for w in worlds)
+    return from_objects(str(path), objects, first_frame=MOT_FIRST_FRAME, checked=not bad)
 
 
 # ----------------------------------------------------------------------------- tracks.csv, KTP
