@@ -222,7 +222,7 @@ def read_mot_tracks(path: Path, text: str | None = None) -> TrackerOutput:
                 height=2.0 * z if world else math.nan,
                 box2d=Box2D(row[2], row[3], row[4], row[5]),
                 visibility=Visibility.VISIBLE,
-                confidence=float(row[6]) if row.shape[0] >= 7 and math.isfinite(row[6]) else None,
+                confidence=float(row[6]) if len(row) >= 7 and math.isfinite(row[6]) else None,
             )
         )
     frames = tuple((f, 0, tuple(by_frame[f])) for f in sorted(by_frame))
