@@ -96,39 +96,42 @@ def score(
         out_dir, "report.json", force, command="score", names=["report.md", "report.html"]
     )
     # The output folder is checked and staged before any input is read, as for run.
-    with folder:
-        pairs = sequence_pairs(tracks, gt)
-        rest = (config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame)
-        if cluster is None:
-            sequences = []
-            for name, t, g in pairs:
-                sequences.append(score_sequence(name, t, g, *rest))
-                # The scored sequences (millions of objects on MOT17) live until the report
-                # is written: frozen, the collector's full passes stop rescanning them
-                # (on MOT17-train they took a third of the command's CPU time).
-                gc.freeze()
-        else:  # a task per sequence; results come back, this process writes the report
-            from rgbd_eval.engine import connect, map_ordered, parse_cluster
-            from rgbd_eval.sweep import warm_up
+    try:
+        with folder:
+            pairs = sequence_pairs(tracks, gt)
+            rest = (config.evaluation, max_gap_ns, rules, tracks_topic, config.io.world_frame)
+            if cluster is None:
+                sequences = []
+                for name, t, g in pairs:
+                    sequences.append(score_sequence(name, t, g, *rest))
+                    # The scored sequences (millions of objects on MOT17) live until the report
+                    # is written: frozen, the collector's full passes stop rescanning them
+                    # (on MOT17-train they took a third of the command's CPU time).
+                    gc.freeze()
+            else:  # a task per sequence; results come back, this process writes the report
+                from rgbd_eval.engine import connect, map_ordered, parse_cluster
+                from rgbd_eval.sweep import warm_up
 
-            spec = parse_cluster(cluster, tasks=len(pairs))
-            if spec.address is not None:  # remote workers do not share our working directory
-                pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
-            with connect(spec, warm_up=warm_up) as client:
-                sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
-        analysis = analyse(
-            inputs_of_score(sequences), config.evaluation, curve_points if curve else None
-        )
-        report = write_report(
-            folder,
-            sequences,
-            config.evaluation,
-            max_gap_ns,
-            lambda staging, rep: write_score_html(
-                staging, sequences, rep, config.evaluation.gating, analysis
-            ),
-            analysis,
-        )
+                spec = parse_cluster(cluster, tasks=len(pairs))
+                if spec.address is not None:  # remote workers do not share our working directory
+                    pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
+                with connect(spec, warm_up=warm_up) as client:
+                    sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
+            analysis = analyse(
+                inputs_of_score(sequences), config.evaluation, curve_points if curve else None
+            )
+            report = write_report(
+                folder,
+                sequences,
+                config.evaluation,
+                max_gap_ns,
+                lambda staging, rep: write_score_html(
+                    staging, sequences, rep, config.evaluation.gating, analysis
+                ),
+                analysis,
+            )
+    finally:  # the objects frozen here (and any before) are collectable again
+        gc.unfreeze()
     if json_out:
         typer.echo(json.dumps(report, indent=2))
         return
