@@ -436,6 +436,12 @@ class RestBody:
         skin_r, skin_t = self.skinning(pose)
         return _skin(self.vertices, self.model.skin_bone, self.model.skin_weight, skin_r, skin_t)
 
+    def skinned(self, vertices: F64, pose: Pose) -> F64:
+        """Other rest positions of this body's mesh vertices (V, 3), e.g. pushed out by the
+        thickness of clothes, in ``pose`` with this body's skinning weights."""
+        skin_r, skin_t = self.skinning(pose)
+        return _skin(vertices, self.model.skin_bone, self.model.skin_weight, skin_r, skin_t)
+
     def walk_vertices(
         self,
         phase: float,

@@ -64,6 +64,7 @@ def _clip_bbox(
 
 def _cast_into(
     vertices: F64,
+    projected: F64,
     triangles: I32,
     triangle_offset: int,
     directions: F64,
@@ -79,6 +80,7 @@ def _cast_into(
 ) -> None:
     """Update the nearest hits of the rays with the triangles (all in the rays' frame).
 
+    ``projected`` (V, 2) holds each vertex's grid coordinates (for vertices at ``z >= near``).
     ``grid`` is (fx, fy, cx, cy, near) and ``grid_size`` (width, height) of the cell grid;
     the rays of cell ``k = row * width + col`` are ``cell_rays[cell_start[k]:cell_start[k+1]]``.
     A hit counts when ``near_t < t < t_max[ray]`` (``near_t`` = ``grid[4]`` times the ray's z).
@@ -86,19 +88,30 @@ def _cast_into(
     fx, fy, cx, cy, near = grid[0], grid[1], grid[2], grid[3], grid[4]
     gw, gh = grid_size[0], grid_size[1]
     for k in range(triangles.shape[0]):
-        a = vertices[triangles[k, 0]]
-        b = vertices[triangles[k, 1]]
-        c = vertices[triangles[k, 2]]
-        if a[2] < near and b[2] < near and c[2] < near:
+        ia, ib, ic = triangles[k, 0], triangles[k, 1], triangles[k, 2]
+        a = vertices[ia]
+        b = vertices[ib]
+        c = vertices[ic]
+        in_a, in_b, in_c = a[2] >= near, b[2] >= near, c[2] >= near
+        if not (in_a or in_b or in_c):
             continue
-        bu0, bv0, bu1, bv1, found = _clip_bbox(a, b, c, fx, fy, cx, cy, near)
-        if not found:
+        if in_a and in_b and in_c:  # wholly ahead: the corners' projections bound it
+            bu0 = min(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bu1 = max(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bv0 = min(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+            bv1 = max(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+        else:
+            bu0, bv0, bu1, bv1, found = _clip_bbox(a, b, c, fx, fy, cx, cy, near)
+            if not found:
+                continue
+        # the cells [i - 1/2, i + 1/2) the box touches (a pixel's ray lies at its cell's
+        # centre); 1e-6 of a cell more on each side for the rounding of the projections
+        if bu1 < -1.0 or bv1 < -1.0 or bu0 > gw or bv0 > gh:
             continue
-        # cells whose centre may lie in the box, one cell of margin for rounding
-        i0 = max(int(np.floor(bu0)) - 1, 0)
-        j0 = max(int(np.floor(bv0)) - 1, 0)
-        i1 = min(int(np.ceil(bu1)) + 1, gw - 1)
-        j1 = min(int(np.ceil(bv1)) + 1, gh - 1)
+        i0 = max(int(np.floor(bu0 + 0.5 - 1e-6)), 0)
+        j0 = max(int(np.floor(bv0 + 0.5 - 1e-6)), 0)
+        i1 = min(int(np.floor(bu1 + 0.5 + 1e-6)), gw - 1)
+        j1 = min(int(np.floor(bv1 + 0.5 + 1e-6)), gh - 1)
         if i0 > i1 or j0 > j1:
             continue
         e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
@@ -189,8 +202,15 @@ class RayBundle:
         """Keep the nearer hits of these triangles (vertices in the rays' frame)."""
         if triangles.shape[0] == 0:
             return
+        v = np.ascontiguousarray(vertices, dtype=np.float64)
+        fx, fy, cx, cy, near = self._grid
+        z = np.where(v[:, 2] >= near, v[:, 2], 1.0)  # the others are never read
+        projected = np.empty((len(v), 2))
+        projected[:, 0] = fx * (v[:, 0] / z) + cx
+        projected[:, 1] = fy * (v[:, 1] / z) + cy
         _cast_kernel(
-            np.ascontiguousarray(vertices, dtype=np.float64),
+            v,
+            projected,
             np.ascontiguousarray(triangles, dtype=np.int32),
             int(triangle_offset),
             self.directions,
