@@ -18,8 +18,8 @@ from rgbd_eval.bench import LATE_STAGES, READ_STAGES, SCHEMA_VERSION, BenchResul
 from rgbd_eval.cli.bench_cmd import bench
 from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.detect.basso2012 import STAGES
 from rgbd_eval.errors import ConfigError, InputError
+from rgbd_eval.methods.basso2012.detector import STAGES
 from rgbd_eval.sim import load_scenario, synthesize
 
 FRAMES = 10

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from rgbd_eval.chunked import ChunkPlan, advance, advance_cost, detect_chunk, join, resumable
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig, build_config, load_config
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.detect.basso2012 import Basso2012Detector
 from rgbd_eval.detect.ground import GroundState
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.io.reader import Recording
+from rgbd_eval.io.recording import Recording
+from rgbd_eval.methods.basso2012.detector import Basso2012Detector
 from rgbd_eval.pipeline import detect_sequence, open_for
 from rgbd_eval.sim import load_scenario, synthesize
 

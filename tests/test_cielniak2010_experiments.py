@@ -5,13 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 from rgbd_eval.config import load_config
-from rgbd_eval.experiments.cielniak2010 import (
+from rgbd_eval.io.groundtruth import from_objects
+from rgbd_eval.methods.cielniak2010.experiments import (
     check_claims,
     occluded_share,
     paper_values,
     plan_variants,
 )
-from rgbd_eval.io.groundtruth import from_objects
 from rgbd_eval.types import Box2D, GroundTruthObject
 
 
@@ -121,7 +121,7 @@ def test_a_missing_switch_counts_as_off() -> None:
 
 def test_html_page_reads_the_paper_file() -> None:
     from rgbd_eval.plugins import ReproduceResult
-    from rgbd_eval.report_html import reproduce_page
+    from rgbd_eval.report.html.pages import reproduce_page
 
     claim = {"sentence": "s", "source": "section 7", "evidence": "e", "held": True}
     result = ReproduceResult(markdown="# x\n", data={"claims": [claim]}, claims=(("s", True),))

@@ -7,20 +7,21 @@ import math
 import numpy as np
 import pytest
 
-from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
-from rgbd_eval.experiments.dmtbs import (
+from rgbd_eval.methods.dmtbs.detector import DmtbsDetectorConfig
+from rgbd_eval.methods.dmtbs.experiments import (
     arc_camera,
+    check_claims,
     left_object,
     left_object_frames,
     run_frames,
     with_noise,
     yaw_error,
 )
-from rgbd_eval.methods.dmtbs import check_claims
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.methods.dmtbs.tracker import DmtbsTrackerConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.tof import TofFrame, TofImage
-from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
 from rgbd_eval.types import GroundTruthObject, Pose
 
 CAM = StaticDepthCamera(
@@ -206,7 +207,7 @@ def _walker_scene() -> Scenario:
 
 
 def test_camera_angle_pools_the_runs_of_each_angle() -> None:
-    from rgbd_eval.experiments.dmtbs import camera_angle
+    from rgbd_eval.methods.dmtbs.experiments import camera_angle
 
     scene = _walker_scene()
     det = DmtbsDetectorConfig(init_frames=10, roi=(-2, -2, 2, 2), min_blob_area_m2=0.0)

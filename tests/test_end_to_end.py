@@ -8,7 +8,7 @@ import pytest
 
 from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.pipeline import detect_and_track, detect_sequence, run_sequence, track_sequence
 from rgbd_eval.sim import load_scenario, synthesize
 

@@ -10,7 +10,8 @@ import pytest
 
 from rgbd_eval.config import load_config
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.follow import (
+from rgbd_eval.io.recording import open_recording
+from rgbd_eval.methods.satake2009.follow import (
     FollowControl,
     drive,
     follow,
@@ -20,7 +21,6 @@ from rgbd_eval.follow import (
     wheel_command,
     write_follow,
 )
-from rgbd_eval.io.reader import open_recording
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import parse_scenario
@@ -153,8 +153,8 @@ def test_the_method_runs_on_one_opencv_thread_and_its_cpu_time_excludes_renderin
     # process_time counts no thread pool), and its setting is restored afterwards.
     import cv2
 
-    from rgbd_eval import follow as follow_module
-    from rgbd_eval.detect.protocol import create_detector as real
+    from rgbd_eval.components import create_detector as real
+    from rgbd_eval.methods.satake2009 import follow as follow_module
 
     seen: list[int] = []
 

@@ -5,11 +5,10 @@ from __future__ import annotations
 import pytest
 
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.experiments.pinto2022 import check_claims, render, trinet_to_units
 from rgbd_eval.methods.pinto2022 import DATASET, TEST
+from rgbd_eval.methods.pinto2022.experiments import check_claims, render, trinet_to_units
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.report_html import reproduce_page
-from rgbd_eval.report_html.pages import paper_file
+from rgbd_eval.report.html.pages import paper_file, reproduce_page
 from rgbd_eval.sim import load_scenario
 
 
@@ -67,7 +66,7 @@ def test_scenarios_follow_table_one() -> None:
 
 def test_reproduce_page_loads_the_paper_file() -> None:
     # `reproduce pinto2022` writes reproduce.html through the shared paper loader, which
-    # refused configs/papers/pinto2022.yaml (exit 4) while its claims were a list.
+    # refused methods/pinto2022/paper.yaml (exit 4) while its claims were a list.
     paper = paper_file("pinto2022")
     assert paper is not None
     assert set(paper["claims"]) == {"barely_move", "errors_move", "chosen_pair", "frame_rate"}

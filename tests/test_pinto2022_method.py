@@ -5,14 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from rgbd_eval.components import create_detector, create_tracker
 from rgbd_eval.config import load_config
-from rgbd_eval.detect.pinto2022 import Pinto2022Detector
-from rgbd_eval.detect.pinto2022_config import Pinto2022DetectorConfig, ReidBackend
-from rgbd_eval.detect.protocol import create_detector
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.track.pinto2022 import Pinto2022Tracker
-from rgbd_eval.track.pinto2022_config import Pinto2022TrackerConfig
-from rgbd_eval.track.protocol import create_tracker
+from rgbd_eval.methods.pinto2022.detector import Pinto2022Detector
+from rgbd_eval.methods.pinto2022.detector_config import Pinto2022DetectorConfig, ReidBackend
+from rgbd_eval.methods.pinto2022.tracker import Pinto2022Tracker
+from rgbd_eval.methods.pinto2022.tracker_config import Pinto2022TrackerConfig
 from rgbd_eval.types import Box2D, Detection
 
 

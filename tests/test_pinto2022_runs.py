@@ -13,8 +13,8 @@ from typer.testing import CliRunner
 from rgbd_eval.cli.main import app
 from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.detect.pinto2022_config import Pinto2022DetectorConfig
-from rgbd_eval.experiments.pinto2022 import frame_rate
+from rgbd_eval.methods.pinto2022.detector_config import Pinto2022DetectorConfig
+from rgbd_eval.methods.pinto2022.experiments import frame_rate
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.sim import load_scenario, synthesize
 

@@ -102,7 +102,7 @@ def test_unknown_method_exits_4_naming_the_known_ones(tmp_path: Path) -> None:
 def test_discovery_loads_no_simulator() -> None:
     """Every CLI call and Dask worker runs plug-in discovery; it must not pull in the renderer.
 
-    ``rgbd_eval.experiments`` (reproduce only) is outside the scanned packages; importing
+    A method's experiments (reproduce only) are named by its package, not imported; importing
     ``rgbd_eval.sim`` there cost every call ~1.3 CPU s of open3d before it moved.
     """
     code = (

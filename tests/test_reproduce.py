@@ -8,7 +8,7 @@ import pytest
 
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.reproduce import (
+from rgbd_eval.methods.basso2012.experiments import (
     THRESHOLDS,
     VOXEL_SIZES,
     Reproduction,

@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-import rgbd_eval.reproduce as reproduce
+import rgbd_eval.methods.basso2012.experiments as reproduce
 from rgbd_eval.config import RunConfig, load_config
 from tests.io.conftest import Spec, write_recording
 

@@ -6,13 +6,13 @@ from typing import Any
 
 import pytest
 
-from rgbd_eval.experiments.satake2009 import (
+from rgbd_eval.methods.satake2009.experiments import (
     PersonRecord,
     check_claims,
     paper_values,
     person_records,
 )
-from rgbd_eval.follow import FollowResult, FollowStep, FollowSummary
+from rgbd_eval.methods.satake2009.follow import FollowResult, FollowStep, FollowSummary
 from rgbd_eval.metrics.clear import FrameEvents, Match
 from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
 

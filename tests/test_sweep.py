@@ -9,8 +9,8 @@ import pytest
 from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.config import build_config, load_config
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.files import file_digest
 from rgbd_eval.pipeline import run_sequence
-from rgbd_eval.report import file_digest
 from rgbd_eval.sweep import SweepParam, expand_grid, parse_param, point_configs, run_sweep
 from tests.io.conftest import Spec, write_recording
 

@@ -20,7 +20,7 @@ from rgbd_eval.cli.main import app
 from rgbd_eval.config import RunConfig, load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.engine import ClusterSpec, connect
-from rgbd_eval.report import file_digest
+from rgbd_eval.files import file_digest
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import (
     CacheMode,

@@ -47,7 +47,7 @@ from rgbd_eval.io.cvat import (
 from rgbd_eval.io.epfl_rgbd import MIN_TORSO_PIXELS, TORSO_BAND_M, TORSO_COLUMNS, TORSO_ROWS
 from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.images import encode_color_jpeg
-from rgbd_eval.io.reader import Recording, open_recording
+from rgbd_eval.io.recording import Recording, open_recording
 from rgbd_eval.metrics.selection import is_scored_track
 from rgbd_eval.outdir import OutputFolder, check_output_file
 from rgbd_eval.plugins import StreamSpec

@@ -25,6 +25,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+from rgbd_eval.components import needs_frame
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import ConfigError, InputError
 from rgbd_eval.io.benchmark import time_read
@@ -39,7 +40,6 @@ from rgbd_eval.pipeline import (
     track_sequence,
 )
 from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
-from rgbd_eval.track.protocol import needs_frame
 
 SCHEMA_VERSION = 2
 

@@ -39,9 +39,8 @@ from numpy.typing import NDArray
 from rgbd_eval import __version__
 from rgbd_eval.config import RunConfig
 from rgbd_eval.errors import CacheError
-from rgbd_eval.files import read_bytes
+from rgbd_eval.files import file_digest, read_bytes
 from rgbd_eval.pipeline import SequenceDetections
-from rgbd_eval.report import file_digest
 from rgbd_eval.types import Box2D, Box3D, Detection
 
 #: Bump when the Detection layout or the detector's behaviour changes incompatibly.
@@ -298,7 +297,7 @@ class DetectionCache:
         return self._read_memo(memo)
 
     def digest(self, recording: Path) -> str:
-        """The recording's :func:`~rgbd_eval.report.file_digest`, memoised under ``digests/``
+        """The recording's :func:`~rgbd_eval.files.file_digest`, memoised under ``digests/``
         by the files' (path, size, mtime_ns, ctime_ns, inode, device): a warm sweep does
         not read every recording again. A memo that does not parse is recomputed; OSError
         when the recording cannot be read."""

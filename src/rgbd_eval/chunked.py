@@ -14,7 +14,7 @@ rest of the chain. The joined chunks equal the sequential run bit for bit
 
 Cost: the chain re-reads and re-runs the ground stages of every chunk but the
 last: with K chunks, ``(K-1)/K`` of those stages again. Each task reads its own
-frames only (:meth:`~rgbd_eval.io.reader.Recording.frames` starts at the first
+frames only (:meth:`~rgbd_eval.io.recording.Recording.frames` starts at the first
 one's log time), so no chunk or link re-reads the frames before it.
 """
 
@@ -24,10 +24,11 @@ import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig
-from rgbd_eval.detect.protocol import ResumableDetector, create_detector
+from rgbd_eval.detect.protocol import ResumableDetector
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.io.reader import Recording
+from rgbd_eval.io.recording import Recording
 from rgbd_eval.pipeline import SequenceDetections, detect_sequence
 
 #: Fewest frames worth a chunk of their own when the chunk count is chosen automatically:

@@ -12,7 +12,7 @@ from typing import Any
 
 from rgbd_eval.errors import CompareInputError
 from rgbd_eval.io import provenance
-from rgbd_eval.report import REPORT_SCHEMA_VERSION
+from rgbd_eval.report.run import REPORT_SCHEMA_VERSION
 
 
 class Better(enum.Enum):

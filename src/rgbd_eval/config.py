@@ -3,7 +3,7 @@
 A run is configured by one :class:`RunConfig`: the method, how recordings are read,
 the detector's and the tracker's config models (registered by name, see
 :mod:`rgbd_eval.plugins`) and the scoring. Each method's defaults are its paper's
-published parameters, restated in ``configs/methods/<method>.yaml``. Overrides use
+published parameters, restated in its package's ``methods/<method>/method.yaml``. Overrides use
 dotted keys::
 
     tracker.min_confidence=-1.0     detector.voxel_size=0.08     io.max_sync_gap_ms=20
@@ -531,6 +531,15 @@ def load_yaml(path: Path) -> dict[str, Any]:
     return data
 
 
+def paper_path(method: str) -> Path | None:
+    """The file of a method's published numbers and claim thresholds (its package's
+    ``paper.yaml``, :attr:`~rgbd_eval.plugins.MethodSpec.paper_file`), None when it has none."""
+    from rgbd_eval.plugins import method_spec
+
+    spec = method_spec(method)
+    return None if spec.paper_file is None else config_dir() / spec.paper_file
+
+
 def load_paper(
     method: str,
     *,
@@ -538,12 +547,14 @@ def load_paper(
     present: Iterable[str] = (),
     path: Path | None = None,
 ) -> dict[str, Any]:
-    """A paper's published numbers and claim thresholds (``configs/papers/<method>.yaml``).
+    """A paper's published numbers and claim thresholds (``methods/<method>/paper.yaml``).
 
     ``mappings`` name keys that must hold a mapping, ``present`` keys that must exist;
     anything else is a :class:`ConfigError` naming the file.
     """
-    source = path or config_dir() / "papers" / f"{method}.yaml"
+    source = path or paper_path(method)
+    if source is None:
+        raise ConfigError(f"method {method!r} has no paper file (MethodSpec.paper_file)")
     data = load_yaml(source)
     for key in mappings:
         if not isinstance(data.get(key), dict):
@@ -629,7 +640,3 @@ def data_home() -> Path:
         return repo_root() / "datasets"
     cache = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
     return Path(cache) / "rgbd-eval" / "datasets"
-
-
-def methods_dir() -> Path:
-    return config_dir() / "methods"

@@ -104,10 +104,17 @@ def check_transport(address: str) -> None:
 
 
 @contextmanager
-def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator[Client]:
+def connect(
+    spec: ClusterSpec,
+    timeout_s: float = CONNECT_TIMEOUT_S,
+    warm_up: Callable[[], None] | None = None,
+) -> Iterator[Client]:
     """A client of the cluster ``spec``; a local cluster is started and shut down with it.
 
-    A remote scheduler must answer, and have a worker, within ``timeout_s``.
+    A remote scheduler must answer, and have a worker, within ``timeout_s``. ``warm_up``
+    runs in every new worker process of a local cluster while it starts (e.g.
+    :func:`rgbd_eval.sweep.warm_up`: it imports the task code and the methods there, all
+    workers at once, rather than in each worker's first task).
     """
     import dask
     from distributed import Client
@@ -143,7 +150,7 @@ def connect(spec: ClusterSpec, timeout_s: float = CONNECT_TIMEOUT_S) -> Iterator
         ),
     }
     with dask.config.set(settings):
-        yield from _local(spec)
+        yield from _local(spec, warm_up)
 
 
 def worker_environ(environ: Mapping[str, object]) -> dict[str, object]:
@@ -158,7 +165,7 @@ def worker_environ(environ: Mapping[str, object]) -> dict[str, object]:
     return {k: v for k, v in environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
 
 
-def _local(spec: ClusterSpec) -> Iterator[Client]:
+def _local(spec: ClusterSpec, warm_up: Callable[[], None] | None) -> Iterator[Client]:
     from distributed import Client, LocalCluster
 
     try:
@@ -172,19 +179,9 @@ def _local(spec: ClusterSpec) -> Iterator[Client]:
     except (OSError, RuntimeError) as err:  # RuntimeError: "Nanny failed to start."
         raise ClusterError(f"cannot start a {spec.describe()}: {err}") from err
     with cluster, Client(cluster, set_as_default=False) as client:
-        if spec.workers > 1:
-            client.run(_warm_up)
+        if spec.workers > 1 and warm_up is not None:
+            client.run(warm_up)
         yield client
-
-
-def _warm_up() -> None:
-    """Import the task code and every registered method in a new worker process, all workers
-    at once while the cluster starts, rather than in each worker's first task (measured
-    here: 0.9 CPU s to import the sweep's modules, 0.85 s the methods)."""
-    from rgbd_eval.plugins import load_plugins
-    from rgbd_eval.sweep import run_sweep  # noqa: F401  # the task functions' module
-
-    load_plugins()
 
 
 def map_ordered(

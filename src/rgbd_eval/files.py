@@ -12,6 +12,7 @@ one line.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import stat
 from collections.abc import Callable
@@ -220,3 +221,16 @@ def parse_yaml(text: str, error: ErrorFactory, limit: int = MAX_YAML_VALUES) -> 
     except yaml.YAMLError as err:
         message = " ".join(str(err).split())
         raise error(f"not valid YAML ({message[:300]})") from err
+
+
+def file_digest(path: Path) -> str:
+    """sha256 of a file, or of a folder's files (names and contents, sorted)."""
+    h = hashlib.sha256()
+    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+    for f in files:
+        if path.is_dir():
+            h.update(str(f.relative_to(path)).encode())
+        with f.open("rb") as handle:
+            for block in iter(lambda: handle.read(1 << 20), b""):
+                h.update(block)
+    return h.hexdigest()

@@ -12,14 +12,14 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from rgbd_eval.components import create_detector, create_tracker, needs_frame
 from rgbd_eval.config import Gating, RunConfig
-from rgbd_eval.detect.protocol import ResumableDetector, create_detector
+from rgbd_eval.detect.protocol import ResumableDetector
 from rgbd_eval.errors import ConfigError, GroundTruthError, InputError, ScoringError
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
-from rgbd_eval.io.reader import Recording, RecordingInfo, open_recording
+from rgbd_eval.io.recording import Recording, RecordingInfo, open_recording
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence
 from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
-from rgbd_eval.track.protocol import create_tracker, needs_frame
 from rgbd_eval.types import Detection, Frame, GroundTruthObject, TrackOutput
 
 #: Called after each frame with (frames done, frames in all).

@@ -9,8 +9,10 @@ it reads, its paper and its default gating; a paper registers its experiments fo
 
 Discovery needs no hand-edited import list. :func:`load_plugins` imports
 
-1. every module of the packages :mod:`rgbd_eval.detect`, :mod:`rgbd_eval.track` and
-   :mod:`rgbd_eval.methods` (a package scan: a new module registers by existing);
+1. every package (or module) in :mod:`rgbd_eval.methods`, one per method, found by a
+   package scan (a new method registers by existing): its ``__init__`` registers the
+   detector, tracker, method and paper. The package is named, not imported, here: the
+   registry knows names and specs, and methods import it, never the other way;
 2. every entry point of the group ``rgbd_eval.plugins`` (installed third-party methods);
 3. every module named in ``$RGBD_EVAL_PLUGINS`` (comma-separated; for methods kept in a
    project's own folder, e.g. ``RGBD_EVAL_PLUGINS=my_lab.tracker``).
@@ -43,7 +45,7 @@ if TYPE_CHECKING:
 
 ENTRY_POINT_GROUP = "rgbd_eval.plugins"
 ENV_VAR = "RGBD_EVAL_PLUGINS"
-_SCANNED_PACKAGES = ("rgbd_eval.detect", "rgbd_eval.track", "rgbd_eval.methods")
+_SCANNED_PACKAGES = ("rgbd_eval.methods",)
 
 #: The stream roles a recording can hold (``io.topics.<role>``, ``--topic ROLE=/name``).
 #: Extra depth cameras of a rig are ``depth_2``, ``depth_3``, ... (see :func:`role_kind`).
@@ -136,8 +138,11 @@ class MethodSpec:
     #: The seed (paper text) that specifies it, e.g. ``000`` (see DESIGN.md).
     seed: str = ""
     gating: str = "iou"
-    #: Where the paper's defaults live, relative to the config folder.
-    config_file: str | None = None
+    #: The method's default config (``method.yaml``): an absolute path (a method package's own
+    #: file), or one relative to the config folder.
+    config_file: str | Path | None = None
+    #: The paper's published numbers and claim thresholds (``paper.yaml``), likewise.
+    paper_file: str | Path | None = None
 
 
 @dataclass(frozen=True)
@@ -146,13 +151,29 @@ class PaperSpec:
 
     ``scenarios`` are the synthetic recordings it needs (scenario names or YAML paths);
     ``run`` gets them as ``{name: recording path}`` plus the options, and returns the
-    result to write.
+    result to write. It may be named as ``"module:function"``, imported when the paper is
+    reproduced (:meth:`experiments`): a method's experiments drive runs and sweeps, which
+    find methods through this registry, so a method package names its experiments rather
+    than importing them.
     """
 
     method: str
     title: str
     scenarios: tuple[str, ...]
-    run: Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult]
+    run: Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult] | str
+
+    def experiments(self) -> Callable[[Mapping[str, Path], ReproduceOptions], ReproduceResult]:
+        """The function that runs the experiments (``run``, imported when named)."""
+        if not isinstance(self.run, str):
+            return self.run
+        module, sep, name = self.run.partition(":")
+        try:
+            run = getattr(importlib.import_module(module), name) if sep else None
+        except (ImportError, AttributeError) as err:
+            raise ConfigError(f"paper {self.method!r}: cannot load {self.run!r}: {err}") from err
+        if not callable(run):
+            raise ConfigError(f"paper {self.method!r}: {self.run!r} is not a 'module:function'")
+        return run  # type: ignore[no-any-return]
 
 
 @dataclass(frozen=True)

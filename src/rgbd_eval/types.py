@@ -644,6 +644,16 @@ class TrackOutput:
 
 
 @dataclass(frozen=True)
+class TrackerOutput:
+    """Tracker output of one sequence: (frame, stamp_ns, tracks) sorted by stamp, then frame."""
+
+    source: str
+    frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
+    num_frames: int | None = None
+    """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
+
+
+@dataclass(frozen=True)
 class GroundTruthObject:
     """One annotated person in one frame.
 

@@ -11,7 +11,7 @@ from typer.testing import CliRunner
 
 from rgbd_eval.cli.main import app
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from tests.io.epfl_folder import write_sequence
 
 runner = CliRunner()

@@ -8,7 +8,7 @@ import pytest
 from typer.testing import CliRunner
 
 from rgbd_eval.cli.main import app
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 
 runner = CliRunner()
 

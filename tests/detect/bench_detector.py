@@ -20,8 +20,8 @@ from collections.abc import Sequence
 import cv2
 import numpy as np
 
-from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
+from rgbd_eval.methods.basso2012.detector import STAGES, Basso2012Detector
+from rgbd_eval.methods.basso2012.detector_config import Basso2012DetectorConfig as DetectorConfig
 from rgbd_eval.types import Frame
 
 from .scenes import Block, Person, Scene, camera_pose, render
@@ -61,7 +61,7 @@ def rendered_frames(size: tuple[int, int], n: int = 40) -> list[Frame]:
 def main(argv: Sequence[str]) -> None:
     cv2.setNumThreads(1)
     if argv:
-        from rgbd_eval.io.reader import open_recording
+        from rgbd_eval.io.recording import open_recording
 
         for path in argv:
             time_frames(path, list(open_recording(path).frames()))

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from rgbd_eval.detect import satake2009_templates as st
+from rgbd_eval.methods.satake2009 import templates as st
 from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.render import make_scene, render_hits
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose

@@ -11,12 +11,13 @@ import dataclasses
 import numpy as np
 import pytest
 
+from rgbd_eval.components import create_detector
 from rgbd_eval.config import build_config
-from rgbd_eval.detect import create_detector
-from rgbd_eval.detect.basso2012 import STAGES, Basso2012Detector
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig as DetectorConfig
-from rgbd_eval.detect.basso2012_config import GroundMode, HogBorder, HogClassifier
+from rgbd_eval.detect.ground import GroundMode
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.basso2012.detector import STAGES, Basso2012Detector
+from rgbd_eval.methods.basso2012.detector_config import Basso2012DetectorConfig as DetectorConfig
+from rgbd_eval.methods.basso2012.detector_config import HogBorder, HogClassifier
 from rgbd_eval.plugins import known
 from rgbd_eval.types import OPTICAL_TO_BODY, Detection, Frame
 

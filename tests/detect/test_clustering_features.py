@@ -12,7 +12,7 @@ from rgbd_eval.detect.clustering import (
     merge_close_clusters,
     split_by_heads,
 )
-from rgbd_eval.detect.features import (
+from rgbd_eval.methods.basso2012.features import (
     HEAD_FRACTION,
     Blob,
     blob,

@@ -9,17 +9,18 @@ import pytest
 import yaml
 from pydantic import ValidationError
 
-from rgbd_eval.detect.dmtbs import (
+from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.dmtbs.detector import (
     DepthView,
     DmtbsDetector,
     DmtbsDetectorConfig,
     FloorSource,
 )
-from rgbd_eval.errors import ConfigError
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
-from rgbd_eval.track.dmtbs import DmtbsTrackerConfig
+from rgbd_eval.methods.dmtbs.tracker import DmtbsTrackerConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
 
-METHOD_FILE = Path(__file__).parents[2] / "configs" / "methods" / "dmtbs.yaml"
+METHOD_FILE = Path(__file__).parents[2] / "src" / "rgbd_eval" / "methods" / "dmtbs" / "method.yaml"
 STEP = 33_333_333
 
 

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from rgbd_eval.detect.person2d import ColourImage, PersonBox
-from rgbd_eval.detect.pinto2022 import STAGES, Pinto2022Detector
 from rgbd_eval.detect.reid import ColourTextureEmbedder
+from rgbd_eval.methods.pinto2022.detector import STAGES, Pinto2022Detector
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, Frame
 
 CAM = CameraModel(8, 6, fx=4.0, fy=4.0, cx=3.5, cy=2.5)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rgbd_eval.detect.reid_calibration import (
+from rgbd_eval.methods.pinto2022.reid_calibration import (
     calibrate,
     equal_error_threshold,
     pair_distances,

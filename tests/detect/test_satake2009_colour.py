@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rgbd_eval.detect import satake2009_colour as colour
-from rgbd_eval.detect.satake2009_templates import Match
+from rgbd_eval.methods.satake2009 import colour as colour
+from rgbd_eval.methods.satake2009.templates import Match
 
 # A 40 x 80 px head-to-hip box at 3 m on a 100 x 100 image, head top at row 10:
 # head rows 10..30 (top quarter of 80 rows), torso rows 46..90 (its lower 55 %).

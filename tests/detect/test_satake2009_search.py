@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from rgbd_eval.detect import satake2009_search as search
-from rgbd_eval.detect import satake2009_templates as st
+from rgbd_eval.methods.satake2009 import search as search
+from rgbd_eval.methods.satake2009 import templates as st
 
 from .satake_scenes import CAM
 from .satake_scenes import scene_depth as _scene

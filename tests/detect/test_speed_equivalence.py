@@ -37,8 +37,8 @@ from rgbd_eval.detect.clustering import (
     merge_close_clusters,
     split_by_heads,
 )
-from rgbd_eval.detect.features import blob, colour_histogram, touches_border
 from rgbd_eval.detect.plane import cross3
+from rgbd_eval.methods.basso2012.features import blob, colour_histogram, touches_border
 from rgbd_eval.types import CameraModel
 
 FloatArray = NDArray[np.float64]

@@ -411,7 +411,7 @@ def _config_cases() -> list[Case]:
         _set_case(
             "threshold_inf", ["evaluation.gating=metric", "evaluation.threshold=.inf"], 4, ""
         ),
-        Case(  # a detector/tracker check was blamed on configs/methods/pinto2022.yaml alone
+        Case(  # a detector/tracker check was blamed on methods/pinto2022/method.yaml alone
             "set_reid_units",
             "MISLEADING",
             lambda root: [

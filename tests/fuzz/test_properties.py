@@ -20,7 +20,7 @@ from hypothesis import strategies as st
 from rgbd_eval.compare import compare_reports, load_report
 from rgbd_eval.errors import CompareInputError, GroundTruthError, InputError
 from rgbd_eval.io.groundtruth import load_ground_truth
-from rgbd_eval.io.reader import RecordingInfo, open_recording
+from rgbd_eval.io.recording import RecordingInfo, open_recording
 from tests.fuzz.corpus import BASE_METRICS, GT_HEADER, flip_byte, report
 from tests.io.conftest import Spec, write_recording
 

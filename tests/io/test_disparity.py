@@ -7,13 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rgbd_eval.detect import satake2009_search as search
 from rgbd_eval.detect import stereo
 from rgbd_eval.errors import DecodeError
 from rgbd_eval.io.images import encode_depth_raw
 from rgbd_eval.io.messages import DISPARITY_TYPE, IMAGE_TYPE
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import RecordingWriter
+from rgbd_eval.methods.satake2009 import search as search
 
 from .conftest import PERIOD, RGB_CAM, T0, rgb_image
 

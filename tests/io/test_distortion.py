@@ -14,10 +14,11 @@ import pytest
 
 from rgbd_eval.config import load_config
 from rgbd_eval.detect.cloud import depth_to_cloud
-from rgbd_eval.io.reader import camera_model_from_info, open_recording
+from rgbd_eval.io.decode import camera_model_from_info
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import Container, RecordingWriter
 from rgbd_eval.pipeline import run_sequence
-from rgbd_eval.report import sequence_record
+from rgbd_eval.report.run import sequence_record
 from rgbd_eval.types import CameraModel
 
 from .conftest import PERIOD, T0

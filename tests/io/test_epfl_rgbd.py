@@ -23,7 +23,7 @@ from rgbd_eval.io.epfl_rgbd import (
     start_stamp_ns,
 )
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.types import Box2D, Pose
 from tests.io.epfl_folder import (

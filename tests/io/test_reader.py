@@ -9,9 +9,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from rgbd_eval.io import reader
+from rgbd_eval.io import recording as reader
 from rgbd_eval.io.images import depth_to_mm
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import StreamOptions
 from rgbd_eval.types import OPTICAL_TO_BODY
 

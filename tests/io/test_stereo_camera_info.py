@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 
 from rgbd_eval.detect.stereo import baseline_of
-from rgbd_eval.io.reader import camera_model_from_info
+from rgbd_eval.io.decode import camera_model_from_info
 from rgbd_eval.io.writer import RecordingWriter
 from rgbd_eval.types import CameraModel
 

@@ -12,7 +12,8 @@ import pytest
 
 from rgbd_eval.config import IoConfig
 from rgbd_eval.errors import SyncError, TopicError
-from rgbd_eval.io.reader import ALL_STREAMS, open_recording
+from rgbd_eval.io.recording import open_recording
+from rgbd_eval.io.streams import ALL_STREAMS
 from rgbd_eval.io.writer import RecordingWriter
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose

@@ -12,7 +12,7 @@ import pytest
 from rgbd_eval.config import IoConfig, WheelsConfig
 from rgbd_eval.errors import DecodeError, TopicError
 from rgbd_eval.io import wheels
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.io.writer import RecordingWriter
 from rgbd_eval.types import OPTICAL_TO_BODY, Pose
 

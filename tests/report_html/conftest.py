@@ -15,18 +15,19 @@ from rgbd_eval.cli.main import app
 from rgbd_eval.compare import compare_reports
 from rgbd_eval.config import Gating, load_config
 from rgbd_eval.datasets import scenarios_dir
+from rgbd_eval.files import file_digest
+from rgbd_eval.methods.basso2012.experiments import Claim, Reproduction, to_json
 from rgbd_eval.metrics import Counts
 from rgbd_eval.pipeline import run_sequence
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.report import file_digest, report_dict
-from rgbd_eval.report_html import (
+from rgbd_eval.report.html.pages import (
     bench_page,
     compare_page,
     reproduce_page,
     write_run_html,
     write_sweep_html,
 )
-from rgbd_eval.reproduce import Claim, Reproduction, to_json
+from rgbd_eval.report.run import report_dict
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.sweep import SweepRecord, SweepResult
 

@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from rgbd_eval.config import Convention, EvaluationConfig
 from rgbd_eval.metrics import FrameEvents, Match, evaluate_sequence
-from rgbd_eval.report_html.events import (
+from rgbd_eval.report.html.events import (
     FrameErrors,
     Marker,
     MarkerKind,

@@ -9,8 +9,8 @@ import pytest
 
 from rgbd_eval.errors import OutputError
 from rgbd_eval.metrics import FrameEvents, Match
-from rgbd_eval.report_html.overlay import GT_COLOUR, MISS_COLOUR, draw_frame, track_colour
-from rgbd_eval.report_html.video import frame_rate, write_overlay_video
+from rgbd_eval.report.html.overlay import GT_COLOUR, MISS_COLOUR, draw_frame, track_colour
+from rgbd_eval.report.html.video import frame_rate, write_overlay_video
 from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
 

@@ -168,11 +168,11 @@ def test_reproduce_page_shows_paper_beside_measured_and_claims(pages: dict[str, 
 
 def test_config_diff_lists_only_what_differs_from_the_method_defaults() -> None:
     from rgbd_eval.config import load_config
-    from rgbd_eval.report_html.pages import config_diff
+    from rgbd_eval.report.html.pages import config_diff
 
     assert config_diff(load_config(method="basso2012")) == []
     changed = load_config(None, ["tracker.min_confidence=-1.0"], method="basso2012")
-    # configs/methods/basso2012.yaml keeps Table 6.1's -0.5
+    # methods/basso2012/method.yaml keeps Table 6.1's -0.5
     assert config_diff(changed) == [("tracker.min_confidence", -0.5, -1.0)]
 
 
@@ -211,9 +211,9 @@ def test_score_page_tables(pages: dict[str, Path], score_dir: Path) -> None:
 def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidence() -> None:
     # basso2012's ReproduceResult names each claim by the thesis' sentence; the page still
     # finds its source and evidence in the JSON data.
+    from rgbd_eval.methods.basso2012.experiments import Claim, Reproduction, to_json
     from rgbd_eval.plugins import ReproduceResult
-    from rgbd_eval.report_html.pages import _claims
-    from rgbd_eval.reproduce import Claim, Reproduction, to_json
+    from rgbd_eval.report.html.pages import _claims
 
     res = Reproduction()
     res.claims = [

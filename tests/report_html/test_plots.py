@@ -5,8 +5,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from rgbd_eval.report_html.overlay import track_colour
-from rgbd_eval.report_html.plots import birds_eye
+from rgbd_eval.report.html.overlay import track_colour
+from rgbd_eval.report.html.plots import birds_eye
 from rgbd_eval.types import TrackOutput, Visibility
 
 

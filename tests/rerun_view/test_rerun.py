@@ -15,7 +15,7 @@ from typer.testing import CliRunner
 
 from rgbd_eval.cli.main import app
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.rerun_log import MAX_CLOUD_POINTS
+from rgbd_eval.report.rerun import MAX_CLOUD_POINTS
 from rgbd_eval.sim import load_scenario, synthesize
 
 pytest.importorskip("rerun")  # the `rerun` extra, installed with `dev`

@@ -23,7 +23,8 @@ from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.detect import stereo
 from rgbd_eval.sim import Simulator, load_scenario
-from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig
+from rgbd_eval.sim.rig_config import StereoPairConfig
+from rgbd_eval.sim.stereo_rig import StereoPair
 
 BANDS = ((1.0, 2.0), (2.0, 4.0), (4.0, 6.0), (6.0, 8.0))
 

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from rgbd_eval.datasets import scenarios_dir
+from rgbd_eval.sim.rig_config import ThermalCameraConfig
 from rgbd_eval.sim.scenario import load_scenario
 from rgbd_eval.sim.simulate import Simulator
-from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig
+from rgbd_eval.sim.thermal_camera import ThermalCamera
 
 FOLDER = scenarios_dir() / "cielniak2010"
 

@@ -5,13 +5,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rgbd_eval.experiments.occlusion_training import (
+from rgbd_eval.methods.cielniak2010.occlusion import shipped_classifier
+from rgbd_eval.methods.cielniak2010.occlusion_training import (
     accuracy,
     features_of,
     train_groups,
 )
 from rgbd_eval.sim.occlusion_pairs import MIN_OVERLAP, overlapping_pairs, render_pair
-from rgbd_eval.track.occlusion import shipped_classifier
 
 
 def _overlap(a: tuple[float, ...], b: tuple[float, ...]) -> float:

@@ -9,10 +9,11 @@ import numpy as np
 import pytest
 
 from rgbd_eval.detect import stereo
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import Simulator, parse_scenario, synthesize
-from rgbd_eval.sim.stereo_rig import StereoPair, StereoPairConfig, value_noise
+from rgbd_eval.sim.rig_config import StereoPairConfig
+from rgbd_eval.sim.stereo_rig import StereoPair, value_noise
 
 PAIR: dict[str, Any] = {"kind": "stereo_pair", "name": "stereo", "width": 320, "height": 240}
 SCENARIO: dict[str, Any] = {

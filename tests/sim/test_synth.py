@@ -9,7 +9,7 @@ import pytest
 import yaml
 
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.sim.rig import DEPTH_FRAME, RGB_FRAME
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.simulate import Simulator

@@ -9,7 +9,7 @@ import pytest
 
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import load_ground_truth
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import Simulator, parse_scenario, synthesize
 from rgbd_eval.sim.thermal_camera import (

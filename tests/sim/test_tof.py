@@ -10,12 +10,14 @@ import pytest
 
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.io.groundtruth import load_ground_truth
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.plugins import StreamSpec
 from rgbd_eval.sim import load_scenario, parse_scenario, synthesize
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
+from rgbd_eval.sim.sensor import radial_position, tof_depth, tof_sigma
 from rgbd_eval.sim.simulate import Simulator
-from rgbd_eval.sim.tof import TofRig, radial_position, tof_depth, tof_sigma
+from rgbd_eval.sim.tof import TofRig
 from rgbd_eval.types import CameraModel
 
 SCENE2 = Path(__file__).parents[2] / "configs" / "scenarios" / "dmtbs" / "scene2.yaml"

@@ -22,10 +22,10 @@ from hypothesis import strategies as st
 from numpy.typing import NDArray
 from scipy.linalg import blas
 
-import rgbd_eval.track.basso2012 as basso2012
+import rgbd_eval.methods.basso2012.tracker as basso2012
 import rgbd_eval.track.boosting as boosting
+from rgbd_eval.components import create_tracker
 from rgbd_eval.config import build_config
-from rgbd_eval.track import create_tracker
 from rgbd_eval.track.boosting import (
     _INITIAL_WEIGHT,
     CORNER_SIGNS,

@@ -11,8 +11,7 @@ import numpy as np
 import pytest
 
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.track.adaboost import BoostedStumps, Stump
-from rgbd_eval.track.occlusion import (
+from rgbd_eval.methods.cielniak2010.occlusion import (
     FEATURE_NAMES,
     GROUPS,
     OcclusionClassifier,
@@ -28,6 +27,7 @@ from rgbd_eval.track.occlusion import (
     shipped_classifier,
     sort_front_to_back,
 )
+from rgbd_eval.track.adaboost import BoostedStumps, Stump
 
 RED, GREEN, BLUE = (200, 0, 0), (0, 200, 0), (0, 0, 200)
 

@@ -7,7 +7,8 @@ import pytest
 from scipy import ndimage
 
 from rgbd_eval.sim import Simulator, parse_scenario
-from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig, counts_to_celsius
+from rgbd_eval.sim.rig_config import ThermalCameraConfig
+from rgbd_eval.sim.thermal_camera import ThermalCamera, counts_to_celsius
 from rgbd_eval.track.silhouette import Silhouette, silhouette_scores
 from rgbd_eval.track.thermal_pf import (
     F64,

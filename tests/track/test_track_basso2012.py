@@ -9,12 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rgbd_eval.components import create_tracker
 from rgbd_eval.config import build_config
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.methods.basso2012.tracker import Basso2012Tracker
+from rgbd_eval.methods.basso2012.tracker_config import ClusterSelection
 from rgbd_eval.plugins import known
-from rgbd_eval.track import create_tracker
-from rgbd_eval.track.basso2012 import Basso2012Tracker
-from rgbd_eval.track.basso2012_config import ClusterSelection
 from rgbd_eval.track.synthetic import (
     THREE_PEOPLE,
     colour_histogram,

@@ -9,11 +9,19 @@ import numpy as np
 import pytest
 
 from rgbd_eval.config import build_config
+from rgbd_eval.methods.cielniak2010.occlusion import order, overlap, sort_front_to_back
+from rgbd_eval.methods.cielniak2010.person_geometry import (
+    HeightPrior,
+    height_log_prior,
+    implied_heights,
+)
+from rgbd_eval.methods.cielniak2010.tracker import (
+    Affine,
+    Cielniak2010Tracker,
+    Cielniak2010TrackerConfig,
+)
+from rgbd_eval.methods.cielniak2010.warm_regions import WarmRegionParams, warm_regions
 from rgbd_eval.plugins import DetectionContract
-from rgbd_eval.track.cielniak2010 import Affine, Cielniak2010Tracker, Cielniak2010TrackerConfig
-from rgbd_eval.track.occlusion import order, overlap, sort_front_to_back
-from rgbd_eval.track.person_geometry import HeightPrior, height_log_prior, implied_heights
-from rgbd_eval.track.warm_regions import WarmRegionParams, warm_regions
 from rgbd_eval.types import CameraModel, Frame, Pose, Stream
 
 THERMAL = CameraModel(320, 240, 300.0, 300.0, 159.5, 119.5, (0.0,) * 5, "thermal")

@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from rgbd_eval.track.blob_split import nearest_blob, split_centroids, voronoi_split
-from rgbd_eval.track.dmtbs import DmtbsTracker, DmtbsTrackerConfig
+from rgbd_eval.methods.dmtbs.blob_split import nearest_blob, split_centroids, voronoi_split
+from rgbd_eval.methods.dmtbs.tracker import DmtbsTracker, DmtbsTrackerConfig
 from rgbd_eval.types import Box2D, Detection, TrackStatus, Visibility
 
 STEP_NS = 100_000_000  # 10 Hz keeps the arithmetic short

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.track.pinto2022 import (
+from rgbd_eval.methods.pinto2022.tracker import (
     INFINITE_COST,
     Pinto2022Params,
     Pinto2022Tracker,

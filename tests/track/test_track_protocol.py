@@ -8,9 +8,9 @@ from typing import Literal
 import pytest
 
 from rgbd_eval import plugins
+from rgbd_eval.components import create_tracker
 from rgbd_eval.config import ComponentConfig, build_config
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.track.protocol import create_tracker
 from rgbd_eval.types import Detection, Frame, TrackOutput, Visibility
 
 

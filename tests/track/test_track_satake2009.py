@@ -7,13 +7,17 @@ import math
 import numpy as np
 import pytest
 
-from rgbd_eval.detect.satake2009 import (
+from rgbd_eval.methods.satake2009.detector import (
     Satake2009Contract,
     Satake2009DetectorConfig,
     distance_grid,
 )
+from rgbd_eval.methods.satake2009.tracker import (
+    Satake2009Tracker,
+    Satake2009TrackerConfig,
+    planar_pose,
+)
 from rgbd_eval.plugins import DetectionContract
-from rgbd_eval.track.satake2009 import Satake2009Tracker, Satake2009TrackerConfig, planar_pose
 from rgbd_eval.types import OPTICAL_TO_BODY, Box2D, CameraModel, Detection, Frame, Pose, Stream
 from tests.detect.satake_scenes import CAM as SEARCH_CAM
 from tests.detect.satake_scenes import scene_depth

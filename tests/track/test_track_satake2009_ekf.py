@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from rgbd_eval.track import satake2009_ekf as ekf
+from rgbd_eval.methods.satake2009 import ekf as ekf
 
 
 def _truth_in_robot_frame(

@@ -7,9 +7,9 @@ validate (Table 6.1).
 
 from __future__ import annotations
 
+from rgbd_eval.components import create_tracker
 from rgbd_eval.config import build_config
-from rgbd_eval.track import create_tracker
-from rgbd_eval.track.basso2012 import Basso2012Tracker
+from rgbd_eval.methods.basso2012.tracker import Basso2012Tracker
 from rgbd_eval.track.synthetic import person_detection
 from rgbd_eval.types import Detection, TrackOutput, TrackStatus
 

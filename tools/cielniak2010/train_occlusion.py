@@ -5,9 +5,9 @@
 
 Renders ``--train-pairs`` overlapping pairs for the training seed and ``--test-pairs`` for
 the held-out seed (:mod:`rgbd_eval.sim.occlusion_pairs`), trains one discrete AdaBoost per
-feature group (thermal, colour, both; :mod:`rgbd_eval.experiments.occlusion_training`), prints
+feature group (thermal, colour, both; :mod:`rgbd_eval.methods.cielniak2010.occlusion_training`), prints
 the held-out accuracy per group and writes the stumps with their provenance to
-``src/rgbd_eval/data/cielniak2010_occlusion.json`` (atomically). Same arguments, same file
+``src/rgbd_eval/methods/cielniak2010/occlusion.json`` (atomically). Same arguments, same file
 (on one machine and library versions: the features go through numpy's floating point).
 About 0.3 s of CPU per rendered pair.
 """
@@ -20,14 +20,14 @@ import time
 from pathlib import Path
 
 from rgbd_eval.atomic import write_json
-from rgbd_eval.experiments.occlusion_training import (
+from rgbd_eval.methods.cielniak2010.occlusion import MODEL_PATH
+from rgbd_eval.methods.cielniak2010.occlusion_training import (
     TrainingPlan,
     evaluate,
     model_document,
     render_features,
     train_groups,
 )
-from rgbd_eval.track.occlusion import MODEL_PATH
 
 
 def main(argv: list[str]) -> int:

@@ -7,7 +7,7 @@
 Every variant runs on every recording for every tracker seed (``tracker.seed``); the
 counts are summed over the recordings per seed and the mean (min .. max) over the seeds
 of ID switches, MOTA and IDF1 printed, with the ID switches per recording. The parameters
-of ``configs/methods/cielniak2010.yaml`` were chosen with it on recordings rendered with
+of ``methods/cielniak2010/method.yaml`` were chosen with it on recordings rendered with
 scenario seed 100 and tracker seeds 100-102, never on the seeds ``reproduce`` reports
 (scenario seeds 40/41 of ``configs/scenarios/cielniak2010/``, tracker seeds 0-2).
 """

@@ -20,12 +20,12 @@ from types import SimpleNamespace
 import cv2
 
 from rgbd_eval.config import config_dir, load_config
-from rgbd_eval.detect import dmtbs as detect_dmtbs
-from rgbd_eval.detect.dmtbs import DepthView, DmtbsDetector, DmtbsDetectorConfig
+from rgbd_eval.methods.dmtbs import detector as detect_dmtbs
+from rgbd_eval.methods.dmtbs import tracker as track_dmtbs
+from rgbd_eval.methods.dmtbs.detector import DepthView, DmtbsDetector, DmtbsDetectorConfig
+from rgbd_eval.methods.dmtbs.tracker import DmtbsTracker, DmtbsTrackerConfig
 from rgbd_eval.sim.scenario import load_scenario
 from rgbd_eval.sim.tof import TofRig
-from rgbd_eval.track import dmtbs as track_dmtbs
-from rgbd_eval.track.dmtbs import DmtbsTracker, DmtbsTrackerConfig
 
 
 def main() -> None:

@@ -6,7 +6,7 @@ For every recording (with its ``<name>.gt.csv``), every ground-truth box that is
 fully visible (visibility >= 0.95), inside the image and at least 80 px tall is embedded by
 each embedder. Same-person pairs are taken at least 15 frames (0.5 s) apart, so pose has
 changed; different-person pairs within the same recording. Prints, per embedder: the
-separation (ROC AUC), the thresholds of :mod:`rgbd_eval.detect.reid_calibration`, and
+separation (ROC AUC), the thresholds of :mod:`rgbd_eval.methods.pinto2022.reid_calibration`, and
 milliseconds per crop on one thread; writes the numbers as JSON to stdout with --json.
 """
 
@@ -20,9 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from rgbd_eval.detect.reid import ColourTextureEmbedder, Embedder, builtin_mobilenet
-from rgbd_eval.detect.reid_calibration import calibrate, pair_distances, roc_auc
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
+from rgbd_eval.methods.pinto2022.reid_calibration import calibrate, pair_distances, roc_auc
 
 MIN_VISIBILITY = 0.95
 MIN_HEIGHT_PX = 80.0

@@ -8,7 +8,7 @@ Recordings (each with its ``<name>.gt.csv``): the detector runs with no score th
 every box the network's own NMS keeps (up to 100) is seen. Each scored ground-truth box
 (not ignored, at least ``MIN_HEIGHT_PX`` tall) is matched greedily, best score first, to a
 box with IoU >= 0.5. Printed per recording and in total: recall and precision at the
-published threshold (0.5, ``configs/methods/pinto2022.yaml``); recall at lower thresholds
+published threshold (0.5, ``methods/pinto2022/method.yaml``); recall at lower thresholds
 (what a lower threshold would buy, *not* a recommendation: the threshold stays); and the
 missed people split by why: no box at all within IoU 0.5 (the network does not see a person
 there), a box with a score below 0.5 (seen, but not confidently), and by the person's size
@@ -32,7 +32,7 @@ import numpy as np
 from rgbd_eval.detect.person2d import ColourImage, PersonBox
 from rgbd_eval.detect.ssdlite import SsdLiteDetector, SsdParams
 from rgbd_eval.io.groundtruth import read_csv
-from rgbd_eval.io.reader import open_recording
+from rgbd_eval.io.recording import open_recording
 from rgbd_eval.metrics.gating import iou_matrix
 from rgbd_eval.types import GroundTruthObject
 

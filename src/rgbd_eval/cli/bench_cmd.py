@@ -148,7 +148,7 @@ def bench(
         result = benchmark(target, config, repeat, advance_callback(bar, task))
     if html_file is not None:
         from rgbd_eval.atomic import write_text
-        from rgbd_eval.report_html import bench_page
+        from rgbd_eval.report.html.pages import bench_page
 
         write_text(html_file, bench_page(result, STAGE_LABELS), "bench")
     if json_out:

@@ -66,7 +66,7 @@ def compare(
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison), "compare")
     if html_file is not None:
-        from rgbd_eval.report_html import compare_page
+        from rgbd_eval.report.html.pages import compare_page
 
         write_text(html_file, compare_page(comparison, str(baseline), str(current)), "compare")
     if comparison.regressions:

@@ -55,8 +55,8 @@ def _camera(intrinsics: str | None) -> CameraModel:
 def _camera_pose(floor: str, first_depth: Path, camera: CameraModel) -> Pose | None:
     """The camera in the floor-aligned world (x forward along the floor, z up), or None."""
     from rgbd_eval.detect.calibration import floor_frame, floor_from_depth
-    from rgbd_eval.detect.dmtbs import DmtbsDetectorConfig
     from rgbd_eval.io.epfl_rgbd import read_depth
+    from rgbd_eval.methods.dmtbs.detector import DmtbsDetectorConfig
 
     if floor == "none":
         return None

@@ -23,7 +23,8 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.config import IoConfig, load_config
 from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
-from rgbd_eval.io.reader import ALL_STREAMS, RecordingInfo, open_recording
+from rgbd_eval.io.recording import RecordingInfo, open_recording
+from rgbd_eval.io.streams import ALL_STREAMS
 from rgbd_eval.plugins import StreamSpec
 
 

@@ -52,8 +52,9 @@ def reproduce(
     from rgbd_eval.atomic import write_json, write_text
     from rgbd_eval.cache import DetectionCache
     from rgbd_eval.engine import connect, parse_cluster
-    from rgbd_eval.report_html import reproduce_page
-    from rgbd_eval.sim import ensure_scenario
+    from rgbd_eval.report.html.pages import reproduce_page
+    from rgbd_eval.sim.synth import ensure_scenario
+    from rgbd_eval.sweep import warm_up
 
     # Every option is checked before the scenarios are generated (that takes minutes).
     if data is not None and data.exists() and not data.is_dir():  # was FileExistsError
@@ -68,11 +69,11 @@ def reproduce(
             Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
             for name in spec.scenarios
         }
-        with connect(cluster_spec) as client:
+        with connect(cluster_spec, warm_up=warm_up) as client:
             options = ReproduceOptions(
                 client=client, cache=cache, progress=lambda m: err_console.print(m)
             )
-            result = spec.run(recordings, options)
+            result = spec.experiments()(recordings, options)
         staging = folder.staging
         write_text(staging / "reproduce.md", result.markdown)
         write_json(staging / "reproduce.json", {"method": system, **result.data})

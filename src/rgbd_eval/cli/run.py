@@ -68,7 +68,7 @@ def expand_inputs(paths: list[Path]) -> list[Path]:
 
 def ensure_demo() -> Path:
     """The demo recording, generated on first use (deterministic, a few seconds)."""
-    from rgbd_eval.sim import demo_recording  # imported lazily: open3d is slow to import
+    from rgbd_eval.sim.synth import demo_recording  # imported lazily: open3d is slow to import
 
     path = default_demo()
     if not path.exists():
@@ -77,7 +77,7 @@ def ensure_demo() -> Path:
 
 
 def print_table(results: list[SequenceResult], config: RunConfig) -> None:
-    from rgbd_eval.report import run_notes, table_header, table_rows
+    from rgbd_eval.report.run import run_notes, table_header, table_rows
 
     scored = [r for r in results if r.scores is not None]
     if scored:
@@ -141,8 +141,8 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
-    from rgbd_eval.report import REPORT_FILE, sequence_warnings, write_run
-    from rgbd_eval.report_html import write_run_html
+    from rgbd_eval.report.html.pages import write_run_html
+    from rgbd_eval.report.run import REPORT_FILE, sequence_warnings, write_run
 
     sets = [*(overrides or []), *topic_overrides(topics)]
     if gating is not None:
@@ -159,7 +159,7 @@ def run(
         )
     rrd = None
     if rerun is not None:  # checked before any work, like the output folder
-        from rgbd_eval.rerun_log import RrdOutput
+        from rgbd_eval.report.rerun import RrdOutput
 
         if len(recordings) > 1:
             raise typer.BadParameter(
@@ -182,6 +182,7 @@ def run(
                 results.append(run_sequence(recordings[0], config, gt, advance_callback(bar, task)))
         else:  # a task per recording on the cluster; results come back, this process writes
             from rgbd_eval.engine import connect, map_ordered, parse_cluster
+            from rgbd_eval.sweep import warm_up
 
             spec = parse_cluster(cluster, tasks=len(recordings))
             remote = spec.address is not None  # remote workers do not share our working dir
@@ -189,7 +190,7 @@ def run(
                 (p.resolve() if remote else p, config, gt.resolve() if gt and remote else gt)
                 for p in recordings
             ]
-            with connect(spec) as client, progress_bar() as bar:
+            with connect(spec, warm_up=warm_up) as client, progress_bar() as bar:
                 task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
                 results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
         with progress_bar() as bar:

@@ -70,8 +70,8 @@ def score(
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
-    from rgbd_eval.report_html import write_score_html
-    from rgbd_eval.scoring import score_sequence, table_rows, write_report
+    from rgbd_eval.report.html.pages import write_score_html
+    from rgbd_eval.report.scoring import score_sequence, table_rows, write_report
 
     sets = list(overrides or [])
     for key, value in (("gating", gating), ("convention", convention)):
@@ -96,11 +96,12 @@ def score(
             sequences = [score_sequence(name, t, g, *rest) for name, t, g in pairs]
         else:  # a task per sequence; results come back, this process writes the report
             from rgbd_eval.engine import connect, map_ordered, parse_cluster
+            from rgbd_eval.sweep import warm_up
 
             spec = parse_cluster(cluster, tasks=len(pairs))
             if spec.address is not None:  # remote workers do not share our working directory
                 pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
-            with connect(spec) as client:
+            with connect(spec, warm_up=warm_up) as client:
                 sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
         report = write_report(
             folder,
@@ -114,7 +115,7 @@ def score(
     if json_out:
         typer.echo(json.dumps(report, indent=2))
         return
-    from rgbd_eval.report import table_header
+    from rgbd_eval.report.run import table_header
 
     ev = config.evaluation
     title = (

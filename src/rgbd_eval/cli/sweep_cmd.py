@@ -56,7 +56,7 @@ def _write_outputs(
 ) -> None:
     """``sweep.csv``, ``sweep.json``, ``sweep.html`` (and ``sweep.png``) into the staging
     folder, then publish."""
-    from rgbd_eval.report_html import write_sweep_html
+    from rgbd_eval.report.html.pages import write_sweep_html
 
     tmp = folder.staging
     rows = result.rows()
@@ -141,13 +141,14 @@ def sweep(
     from rgbd_eval.config import load_config
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.metrics import summarize
-    from rgbd_eval.report import format_value
+    from rgbd_eval.report.run import format_value
     from rgbd_eval.sweep import (
         SweepParam,
         expand_grid,
         parse_param,
         point_configs,
         run_sweep,
+        warm_up,
     )
 
     specs: list[SweepParam] = [parse_param(p) for p in params or []]
@@ -196,7 +197,7 @@ def sweep(
     )
     with folder:  # checked and staged before the sweep; published whole or not at all
         start = time.perf_counter()
-        with connect(spec) as client, progress_bar() as bar:
+        with connect(spec, warm_up=warm_up) as client, progress_bar() as bar:
             tasks = {name: bar.add_task(name, total=None) for name in ("detect", "track+score")}
             result = run_sweep(
                 recordings,

@@ -66,9 +66,10 @@ def synth(
 ) -> None:
     """Render scenarios to ROS1 .bag or ROS2 .mcap plus a <name>.gt.csv sidecar; deterministic for a seed."""
     from rgbd_eval.config import parse_overrides
-    from rgbd_eval.sim import dataset_path, load_scenario, scenario_paths, synthesize, write_preview
+    from rgbd_eval.sim.preview import write_preview
+    from rgbd_eval.sim.scenario import load_scenario, scenario_paths
     from rgbd_eval.sim.stereo_rig import with_stereo_rig
-    from rgbd_eval.sim.synth import OWNER, ground_truth_path
+    from rgbd_eval.sim.synth import OWNER, dataset_path, ground_truth_path, synthesize
 
     changes = parse_overrides(overrides or [])
     if rig not in (None, "stereo"):
@@ -91,7 +92,7 @@ def synth(
     if out is not None:  # the recording, its ground truth and (--follow) its following record
         targets += [out, ground_truth_path(out)]
         if follow is not None:
-            from rgbd_eval.follow import follow_paths
+            from rgbd_eval.methods.satake2009.follow import follow_paths
 
             targets += follow_paths(out)
     for target in targets:
@@ -144,7 +145,7 @@ def _follow(
     advance: Callable[[int, int], None],
 ) -> None:
     """``synth --follow``: the closed loop, its recording and its following record."""
-    from rgbd_eval.follow import follow, write_follow
+    from rgbd_eval.methods.satake2009.follow import follow, write_follow
     from rgbd_eval.sim.synth import ground_truth_path
 
     try:

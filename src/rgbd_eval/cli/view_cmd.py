@@ -22,7 +22,7 @@ def view(
     ] = None,
 ) -> None:
     """Write a run's Rerun recording (.rrd) from its report folder and the recording."""
-    from rgbd_eval.rerun_log import RrdOutput, load_run, require_rerun
+    from rgbd_eval.report.rerun import RrdOutput, load_run, require_rerun
 
     require_rerun()  # before reading anything
     views, config = load_run(report_dir, sequence)

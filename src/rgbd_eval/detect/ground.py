@@ -9,14 +9,16 @@ points are seen. Planes live in the depth camera's optical frame.
 
 from __future__ import annotations
 
+import enum
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import NDArray
 from scipy.spatial import cKDTree
 
-from rgbd_eval.detect.basso2012_config import Basso2012DetectorConfig, GroundMode
 from rgbd_eval.detect.plane import (
     fit_plane_least_squares,
     normalise_plane,
@@ -33,6 +35,33 @@ FloatArray = NDArray[np.float64]
 REFINE_PASSES = 2
 #: RANSAC hypotheses of the automatic initialisation.
 RANSAC_ITERATIONS = 256
+
+
+class GroundMode(enum.Enum):
+    """How the detector finds the ground plane first (seed 000, 5.1, 5.4.1)."""
+
+    AUTO = "auto"
+    POINTS = "points"
+    PLANE = "plane"
+
+
+class GroundSettings(Protocol):
+    """What :class:`GroundPlaneEstimator` reads of a detector's config (basso2012's)."""
+
+    @property
+    def ground_mode(self) -> GroundMode: ...
+    @property
+    def ground_points(self) -> Sequence[tuple[float, float, float]] | None: ...
+    @property
+    def ground_plane(self) -> tuple[float, float, float, float] | None: ...
+    @property
+    def ground_pixels(self) -> Sequence[tuple[float, float]] | None: ...
+    @property
+    def ground_max_tilt_deg(self) -> float: ...
+    @property
+    def ground_min_points(self) -> int: ...
+    @property
+    def voxel_size(self) -> float: ...
 
 
 def gravity_up_in_optical(camera_pose: Pose) -> FloatArray:
@@ -117,7 +146,7 @@ class GroundState:
 class GroundPlaneEstimator:
     """Holds the plane from frame to frame; one instance per sequence."""
 
-    def __init__(self, config: Basso2012DetectorConfig) -> None:
+    def __init__(self, config: GroundSettings) -> None:
         self._config = config
         self.plane: FloatArray | None = None
         self.inliers = 0

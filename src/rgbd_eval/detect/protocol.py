@@ -7,7 +7,8 @@ order and create a fresh detector per sequence; given the same frames in the
 same order it must return the same detections, bit for bit.
 
 Detectors register with :func:`rgbd_eval.plugins.register_detector` (name, config
-model, factory, the streams they read, their detection contract, their stages).
+model, factory, the streams they read, their detection contract, their stages);
+:func:`rgbd_eval.components.create_detector` makes one by name.
 Stage timing is part of the protocol: after each call, ``last_timings`` holds the
 seconds of each named stage (empty when the detector does not split its work), so
 ``bench`` lists any detector's stages.
@@ -23,8 +24,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Protocol, runtime_checkable
 
-from rgbd_eval.config import RunConfig
-from rgbd_eval.plugins import detector_spec
 from rgbd_eval.types import Detection, Frame
 
 
@@ -70,8 +69,3 @@ class ResumableDetector(Detector, Protocol):
     def advance(self, frame: Frame) -> None:
         """Update the carried state over ``frame`` exactly as :meth:`detect` would, without detecting."""
         ...
-
-
-def create_detector(config: RunConfig) -> Detector:
-    """A new detector for ``config.detector`` (ConfigError for an unknown name)."""
-    return detector_spec(config.detector.name).factory(config.detector)

@@ -11,7 +11,7 @@ One protocol, three backends:
   gradient-orientation histograms over horizontal body stripes), fast and weights-free.
 
 Distances are Euclidean between embeddings (eq. 16), so thresholds are in each embedder's
-own units; ``configs/methods/pinto2022.yaml`` records them per embedder.
+own units; ``methods/pinto2022/method.yaml`` records them per embedder.
 """
 
 from __future__ import annotations

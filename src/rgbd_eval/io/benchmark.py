@@ -12,7 +12,8 @@ from rosbags.highlevel import AnyReader
 from rosbags.rosbag1 import Reader as Ros1Reader
 
 from rgbd_eval.config import IoConfig
-from rgbd_eval.io.reader import RGBD_STREAMS, open_recording
+from rgbd_eval.io.recording import open_recording
+from rgbd_eval.io.streams import RGBD_STREAMS
 from rgbd_eval.plugins import StreamSpec
 
 

@@ -40,8 +40,7 @@ from rgbd_eval.io.track_message_types import (
     SPENCER_TYPE,
     TRACK_TYPES,
 )
-from rgbd_eval.io.tracks import TrackerOutput
-from rgbd_eval.types import Box2D, Pose, TrackOutput, Visibility
+from rgbd_eval.types import Box2D, Pose, TrackerOutput, TrackOutput, Visibility
 
 
 def _stamp(msg: Any) -> int:

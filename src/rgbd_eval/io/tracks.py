@@ -49,7 +49,7 @@ from rgbd_eval.io.groundtruth import (
     require_objects,
 )
 from rgbd_eval.io.validate import MAX_FRAME, MAX_PIXELS, position_problem
-from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, Visibility
+from rgbd_eval.types import Box2D, GroundTruthObject, TrackerOutput, TrackOutput, Visibility
 
 
 class Benchmark(enum.Enum):
@@ -70,16 +70,6 @@ _DISTRACTORS = {
     Benchmark.MOT17: frozenset({2, 7, 8, 12}),
     Benchmark.MOT20: frozenset({2, 6, 7, 8, 12}),
 }
-
-
-@dataclass(frozen=True)
-class TrackerOutput:
-    """Tracker output of one sequence: (frame, stamp_ns, tracks) sorted by stamp, then frame."""
-
-    source: str
-    frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
-    num_frames: int | None = None
-    """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
 
 
 @dataclass(frozen=True)

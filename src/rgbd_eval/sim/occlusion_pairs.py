@@ -21,13 +21,14 @@ from numpy.typing import NDArray
 
 from rgbd_eval import exact
 from rgbd_eval.sim.annotate import projected_extent
+from rgbd_eval.sim.rig_config import ThermalCameraConfig
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.sim.simulate import Simulator
-from rgbd_eval.sim.thermal_camera import ThermalCamera, ThermalCameraConfig, counts_to_celsius
+from rgbd_eval.sim.thermal_camera import ThermalCamera, counts_to_celsius
 from rgbd_eval.sim.world import NO_HIT
 
 Box = tuple[float, float, float, float]
-#: The nominal depth of the thermal-to-colour affine map (configs/methods/cielniak2010.yaml,
+#: The nominal depth of the thermal-to-colour affine map (methods/cielniak2010/method.yaml,
 #: ``tracker.alignment_depth_m``), so the training pairs are aligned as the tracker aligns.
 ALIGNMENT_DEPTH_M = 3.0
 #: A pair counts as overlapping when the boxes share this share of the smaller box.

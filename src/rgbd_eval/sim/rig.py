@@ -1,4 +1,4 @@
-"""The robot's sensor rig: camera models and the tf tree.
+"""The robot's sensor rig: camera models and the tf tree; the view a rig sensor renders from.
 
 Frames (REP-103/105): ``odom`` -> ``base_link`` (odometry) -> ``camera_link``
 (static: ahead, up, tilted) -> ``camera_rgb_optical_frame`` and
@@ -11,12 +11,21 @@ sits ``depth_offset_m`` to the RGB camera's left and the IR projector
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
+from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim.meshes import rotation_y, rotation_z
 from rgbd_eval.sim.scenario import Robot, Sensor
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose
+
+if TYPE_CHECKING:
+    from rgbd_eval.io.writer import RecordingWriter
+    from rgbd_eval.sim.render import Hits
 
 WORLD_FRAME = "odom"
 BASE_FRAME = "base_link"
@@ -78,3 +87,46 @@ def base_pose(x: float, y: float, yaw: float) -> Pose:
     T[:3, :3] = rotation_z(yaw)
     T[:3, 3] = (x, y, 0.0)
     return Pose.from_matrix(T)
+
+
+def pinhole_from_fov(
+    width: int, height: int, hfov_deg: float, vfov_deg: float, frame_id: str
+) -> CameraModel:
+    """An undistorted camera with the given fields of view, principal point at the centre."""
+    fx = (width / 2.0) / exact.tan(math.radians(hfov_deg) / 2.0)
+    fy = (height / 2.0) / exact.tan(math.radians(vfov_deg) / 2.0)
+    return CameraModel(
+        width, height, fx, fy, (width - 1) / 2.0, (height - 1) / 2.0, (0.0,) * 5, frame_id
+    )
+
+
+@dataclass(frozen=True)
+class SceneView:
+    """One instant of the scene, for a rig sensor to render and write."""
+
+    index: int
+    stamp_ns: int
+    world_frame: str
+    #: Ray-cast static scene + people from ``pose`` (world_T_optical) through ``camera``.
+    render: Callable[[CameraModel, Pose], Hits]
+    rng: np.random.Generator
+    #: world_T_base_link of the robot at this instant (robot-mounted sensors render from it).
+    base_pose: Pose = field(default_factory=Pose.identity)
+    #: Lit colour ((H, W, 3) float32, 0..255) of rendered hits, as the Kinect's RGB is shaded.
+    shade: Callable[[Hits], NDArray[np.float32]] | None = None
+    #: Per-pixel (object id, material) of a :meth:`render` result (``NO_HIT``, -1: nothing).
+    surface: Callable[[Hits], tuple[NDArray[np.int32], NDArray[np.int32]]] | None = None
+    #: The colour camera's true world_T_optical (the thermal camera sits beside it).
+    rgb_pose: Pose = field(default_factory=Pose.identity)
+
+
+class RigSensor(Protocol):
+    """A sensor of the rig: its static tf, and what it writes each frame."""
+
+    def static_transforms(self) -> list[tuple[str, str, Pose]]:
+        """``(parent, child, parent_T_child)`` written once to ``/tf_static``."""
+        ...
+
+    def write(self, writer: RecordingWriter, view: SceneView) -> None:
+        """Render and write this sensor's messages of one frame."""
+        ...

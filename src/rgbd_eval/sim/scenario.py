@@ -32,7 +32,7 @@ from pydantic import (
 from rgbd_eval import exact
 from rgbd_eval.config import config_dir, format_validation_error, load_yaml, set_dotted
 from rgbd_eval.errors import ConfigError
-from rgbd_eval.sim.rig_sensors import RigSensorConfig, rig_sensor_config
+from rgbd_eval.sim.rig_config import RigSensorConfig, rig_sensor_config
 
 Colour = tuple[int, int, int]
 

@@ -39,7 +39,7 @@ from rgbd_eval.sim.render import (
     occluded_towards,
     shade,
 )
-from rgbd_eval.sim.rig_sensors import SceneView
+from rgbd_eval.sim.rig import SceneView
 from rgbd_eval.sim.scenario import Scenario
 from rgbd_eval.sim.sensor import (
     depth_edges,

@@ -16,21 +16,16 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field
 
 from rgbd_eval import exact
 from rgbd_eval.sim import rig
 from rgbd_eval.sim.meshes import rotation_y
-from rgbd_eval.sim.rig_sensors import (
-    RigSensorConfig,
-    RigSensorSpec,
-    SceneView,
-    register_rig_sensor,
-)
+from rgbd_eval.sim.rig import SceneView
+from rgbd_eval.sim.rig_config import StereoPairConfig
 from rgbd_eval.sim.scenario import Scenario, parse_scenario
 from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose
 
@@ -38,23 +33,6 @@ if TYPE_CHECKING:
     from rgbd_eval.io.writer import RecordingWriter
 
 _LATTICE = 64  # period of the noise lattice (cells)
-
-
-class StereoPairConfig(RigSensorConfig):
-    """A stereo camera on the robot, looking ahead (Bumblebee2-like defaults)."""
-
-    kind: Literal["stereo_pair"] = "stereo_pair"
-    x: float = Field(0.1, ge=-2.0, le=2.0, description="ahead of base_link (m)")
-    z: float = Field(1.2, gt=0.0, le=3.0, description="height of the left camera (m)")
-    tilt_deg: float = Field(0.0, ge=-45.0, le=45.0, description="pitched down (positive)")
-    baseline_m: float = Field(0.12, gt=0.0, le=1.0)
-    width: int = Field(1024, ge=16, le=4096)
-    height: int = Field(768, ge=16, le=4096)
-    hfov_deg: float = Field(100.0, gt=10.0, lt=170.0)
-    texture_seed: int = Field(0, ge=0)
-    texture_scale_m: float = Field(0.05, gt=0.0, le=1.0, description="finest texture feature (m)")
-    texture_contrast: float = Field(0.45, ge=0.0, le=0.9)
-    noise_std: float = Field(2.0, ge=0.0, le=50.0, description="image noise (grey levels)")
 
 
 @lru_cache(maxsize=4)
@@ -160,9 +138,6 @@ class StereoPair:
 
     def write(self, writer: RecordingWriter, view: SceneView) -> None:
         self.write_pair(writer, view.stamp_ns, self.render_pair(view))
-
-
-register_rig_sensor(RigSensorSpec("stereo_pair", StereoPairConfig, StereoPair))
 
 
 #: The name of the pair :func:`with_stereo_rig` adds (topics ``/stereo/left/...``).

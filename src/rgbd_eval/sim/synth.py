@@ -23,7 +23,8 @@ from rgbd_eval.io.groundtruth import write_csv
 from rgbd_eval.io.writer import RecordingWriter, StreamOptions
 from rgbd_eval.outdir import check_output_file
 from rgbd_eval.sim import rig
-from rgbd_eval.sim.rig_sensors import RigSensor, make_rig_sensor
+from rgbd_eval.sim.rig import RigSensor
+from rgbd_eval.sim.rig_sensors import make_rig_sensor
 from rgbd_eval.sim.scenario import Scenario, load_scenario, scenario_paths, scenarios_dir
 from rgbd_eval.sim.simulate import SimFrame, Simulator
 from rgbd_eval.types import GroundTruthObject

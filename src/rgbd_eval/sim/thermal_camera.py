@@ -19,21 +19,15 @@ tf ``<colour optical frame> -> <name>_optical_frame`` in ``/tf_static``.
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Literal
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import NDArray
-from pydantic import Field
 
 from rgbd_eval import exact
 from rgbd_eval.sim.meshes import MAT_FLOOR, MAT_SKIN
-from rgbd_eval.sim.rig_sensors import (
-    RigSensorConfig,
-    RigSensorSpec,
-    SceneView,
-    pinhole_from_fov,
-    register_rig_sensor,
-)
+from rgbd_eval.sim.rig import SceneView, pinhole_from_fov
+from rgbd_eval.sim.rig_config import ThermalCameraConfig
 from rgbd_eval.types import Pose
 
 if TYPE_CHECKING:
@@ -57,35 +51,6 @@ def counts_to_celsius(counts: NDArray[np.integer]) -> NDArray[np.float64]:
     """``mono16`` counts back to deg C."""
     out: NDArray[np.float64] = counts.astype(np.float64) / COUNTS_PER_KELVIN - _ZERO_C_K
     return out
-
-
-class ThermalCameraConfig(RigSensorConfig):
-    """A thermal camera on the colour camera. Temperatures in deg C.
-
-    Defaults: 320x240 (the NEC Thermal Tracer TS7302 of seed 004, section 2, is a
-    320x240 microbolometer); skin 34 C and clothing 28 C surface temperatures in a 20 C
-    room (typical indoor values; the clothing surface lies between skin and air).
-    """
-
-    kind: Literal["thermal"] = "thermal"
-    width: int = Field(320, ge=16, le=2048)
-    height: int = Field(240, ge=16, le=2048)
-    hfov_deg: float = Field(56.0, gt=5.0, lt=170.0)
-    vfov_deg: float = Field(43.0, gt=5.0, lt=170.0)
-    baseline_m: float = Field(0.06, ge=-0.5, le=0.5, description="right of the colour camera")
-    offset_y_m: float = Field(0.0, ge=-0.5, le=0.5, description="below the colour camera")
-    ambient_c: float = Field(20.0, ge=-30.0, le=45.0)
-    floor_c: float = Field(19.0, ge=-30.0, le=45.0)
-    skin_c: float = Field(34.0, ge=20.0, le=40.0)
-    clothing_c: float = Field(28.0, ge=10.0, le=40.0)
-    warm_obstacles: dict[int, float] = Field(
-        default_factory=dict, description="obstacle index -> surface temperature (C)"
-    )
-    limb_contrast: float = Field(
-        0.25, ge=0.0, le=1.0, description="share of the contrast lost at grazing view"
-    )
-    blur_px: float = Field(0.7, ge=0.0, le=10.0, description="Gaussian optics blur sigma")
-    netd_k: float = Field(0.08, ge=0.0, le=2.0, description="noise sigma (K)")
 
 
 class ThermalCamera:
@@ -154,6 +119,3 @@ class ThermalCamera:
         # always draw the noise so the stream stays aligned whatever netd_k is
         t = t + exact.standard_normal(view.rng, t.shape) * c.netd_k
         return celsius_to_counts(t)
-
-
-register_rig_sensor(RigSensorSpec("thermal", ThermalCameraConfig, ThermalCamera))

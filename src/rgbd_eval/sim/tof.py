@@ -3,7 +3,8 @@
 The seed's simulated sensor has the Kinect v2's properties: 512x424 depth at 30 Hz, noise
 that depends on the depth and on the pixel's distance from the image centre, "at 5 m a
 standard deviation of 5 mm for most of the pixels" (4.3.3). The model (the rig's
-``static_depth`` sensor, :mod:`rgbd_eval.sim.rig_sensors`):
+``static_depth`` sensor, :mod:`rgbd_eval.sim.rig_sensors`; its noise functions,
+:func:`~rgbd_eval.sim.sensor.tof_depth`, are in :mod:`rgbd_eval.sim.sensor`):
 
 ``sigma(z, rho) = noise_k * z^2 * (1 + off_centre_gain * rho^2)`` with ``rho`` the pixel's
 distance from the principal point over the half-diagonal (0 at the centre, ~1 in a corner):
@@ -26,65 +27,14 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from rgbd_eval import exact
-from rgbd_eval.sim.rig_sensors import StaticDepthCamera, StaticDepthConfig
+from rgbd_eval.sim.rig_config import StaticDepthConfig
+from rgbd_eval.sim.rig_sensors import StaticDepthCamera
 from rgbd_eval.sim.scenario import Scenario
-from rgbd_eval.sim.sensor import depth_edges
 from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
 
 F32 = NDArray[np.float32]
 F64 = NDArray[np.float64]
-
-
-def radial_position(camera: CameraModel) -> F32:
-    """Per pixel, the distance from the principal point over the half-diagonal, squared."""
-    u = (np.arange(camera.width, dtype=np.float32) - np.float32(camera.cx)) / np.float32(
-        camera.width / 2.0
-    )
-    v = (np.arange(camera.height, dtype=np.float32) - np.float32(camera.cy)) / np.float32(
-        camera.height / 2.0
-    )
-    rho2: F32 = ((u[None, :] * u[None, :] + v[:, None] * v[:, None]) / np.float32(2.0)).astype(
-        np.float32
-    )
-    return rho2
-
-
-def tof_sigma(z: F64, rho2: F32, cfg: StaticDepthConfig) -> F64:
-    """Noise std per pixel: the sensor's own (depth and off-centre) and the added noise."""
-    own = cfg.noise_k * z * z * (1.0 + cfg.off_centre_gain * rho2)
-    sigma: F64 = np.sqrt(own * own + cfg.extra_noise_m * cfg.extra_noise_m)
-    return sigma
-
-
-def tof_depth(ideal: NDArray[np.floating], cfg: StaticDepthConfig, rng: np.random.Generator) -> F32:
-    """Sensor depth (m, NaN invalid) from the ideal depth (NaN: nothing hit).
-
-    Draws one normal image when there is noise and one uniform image when there is
-    dropout, so that an ideal camera's output and its random stream stay as they were.
-    """
-    z = np.asarray(ideal, dtype=np.float64)
-    valid = np.isfinite(z)
-    if cfg.noise_k > 0.0 or cfg.extra_noise_m > 0.0:
-        camera = _camera_shape(z.shape)
-        rho2 = (
-            radial_position(camera) if cfg.off_centre_gain > 0.0 else np.zeros(z.shape, np.float32)
-        )
-        z = z + exact.standard_normal(rng, z.shape) * tof_sigma(np.where(valid, z, 0.0), rho2, cfg)
-    keep = valid & (z >= cfg.min_range_m) & (z <= cfg.max_range_m)
-    if cfg.edge_dropout > 0.0 or cfg.random_dropout > 0.0:
-        edges = depth_edges(np.asarray(ideal, dtype=np.float32), cfg.edge_jump)
-        p_drop = np.where(edges, cfg.edge_dropout, cfg.random_dropout)
-        keep &= rng.random(z.shape) >= p_drop
-    out: F32 = np.where(keep, z, np.nan).astype(np.float32)
-    return out
-
-
-def _camera_shape(shape: tuple[int, ...]) -> CameraModel:
-    """A camera of this image size with a centred principal point (for ``rho``)."""
-    h, w = shape
-    return CameraModel(w, h, 1.0, 1.0, (w - 1) / 2.0, (h - 1) / 2.0)
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,5 +1,4 @@
-"""Trackers: the protocol, filters, association, and one module per method (registered on import)."""
-
-from rgbd_eval.track.protocol import Tracker, create_tracker, needs_frame
-
-__all__ = ["Tracker", "create_tracker", "needs_frame"]
+"""Tracking building blocks shared by methods: filters (Kalman, UKF, particle filter), the
+motion model, association, online boosting, AdaBoost, colour moments, thermal silhouettes;
+and the tracker protocol (:mod:`rgbd_eval.track.protocol`). Each paper's tracker lives in
+its method package, ``rgbd_eval.methods.<key>``."""

@@ -120,8 +120,8 @@ def time_tracker(
     name: str = "basso2012", frames: int = 750, classifier: bool = True
 ) -> tuple[float, float]:
     """Mean wall-clock and CPU seconds per ``update`` for :data:`THREE_PEOPLE` at 30 Hz."""
+    from rgbd_eval.components import create_tracker
     from rgbd_eval.config import build_config
-    from rgbd_eval.track.protocol import create_tracker
 
     config = build_config({"tracker": {"name": name, "classifier": classifier}})
     stream = walking_stream(THREE_PEOPLE, frames)

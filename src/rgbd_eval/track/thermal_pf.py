@@ -7,7 +7,7 @@ in profile as from the front: with a fixed width, walkers seen from the side wer
 and velocity noise proportional to ``h``, so a near person moves more pixels), and a
 log-normal random walk of the size. The weight of a particle is ``exp(L)`` with ``L`` the
 log-likelihood the caller supplies (the thermal silhouette score over its scale, plus
-the colour and height terms of :mod:`rgbd_eval.track.cielniak2010`), times the
+the colour and height terms of :mod:`rgbd_eval.methods.cielniak2010.tracker`), times the
 interaction factor: several filters run side by side, and a particle overlapping another
 filter's estimate loses ``rho * overlap`` of log-likelihood (overlap: intersection over
 the smaller box, so that a small silhouette on a part of a tracked person, such as its
@@ -42,7 +42,7 @@ STATE_SIZE = 6
 
 @dataclass(frozen=True)
 class FilterParams:
-    """Particle filter settings (values and sources in ``configs/methods/cielniak2010.yaml``)."""
+    """Particle filter settings (values and sources in ``methods/cielniak2010/method.yaml``)."""
 
     n_particles: int = 300
     pos_noise: float = 0.1  # position diffusion, silhouette heights per sqrt(s)
