@@ -48,6 +48,7 @@ LAYERS = [
             "rgbd_eval.sim.meshes",
             "rgbd_eval.sim.figure",
             "rgbd_eval.sim.body",
+            "rgbd_eval.sim.people",
         ],
     ),
     ("sim: world", ["rgbd_eval.sim.world", "rgbd_eval.sim.raster", "rgbd_eval.sim.render"]),

@@ -47,19 +47,19 @@ def _frame_digest(scenario: str, index: int) -> str:
     return h.hexdigest()
 
 
-#: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 2.
+#: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 3.
 PINNED = {
-    ("demo.yaml", 0): "10591af574ec0323bff385440ad5c946c2db5bc7c41030d9046d3fc15203c494",
-    ("demo.yaml", 100): "b0474c5f7894580e99d113ebb062c9689fbb026ffa96d8238f3a7ffe846e8db4",
-    ("moving_complex.yaml", 40): "45558d43e835976985942f8e184a3d5751b2389bdcadd7a33b4d6395d3f7954e",
+    ("demo.yaml", 0): "ceef776d39d66cb7a08e71f10dc1578ad628ebf6750e68f5d49c18f5e98e4864",
+    ("demo.yaml", 100): "4a42bd1e25d5f53e571dd15f881f8441ea2cf37466513b1dff3cfc22b8db8cfa",
+    ("moving_complex.yaml", 40): "4e848f1605cabf2483330410f39d94e4fae5a0d83a5d4add97efb5818639bd20",
     (
         "satake2009_crossing.yaml",
         3,
-    ): "b15580ed5dbaa890cc0949d13ab0cc8599f102ced664ce504b0fb9fffed0c5ca",
+    ): "1e8f6f893c8bddfc5cd487875639bd603f086d70184a20d3bc0ff34bc1c07783",
     (
         "cielniak2010/thermal_crossings.yaml",
         3,
-    ): "b472c49cee02c3f4824308ed9dafe4026fefd85847d2c758e32716846b03ca35",
+    ): "90ca680bc9e21fe4e02fece48a554755b41bb755b2f835a4df298be44c2ac14d",
 }
 
 
@@ -78,7 +78,7 @@ def test_static_depth_cameras_are_the_pinned_bytes() -> None:
     h = hashlib.sha256()
     for image in rig.frame(3).images:
         h.update(image.depth.tobytes())
-    assert h.hexdigest() == "9cf52a7710803b840ff45a1460379e902c32f1a875c957b9a462bd895183a62c"
+    assert h.hexdigest() == "746588dc0de89ea41e145022468f1afe89b03ccebc244b4a9ea6a956c2ea4e26"
 
 
 # ----------------------------------------------------------------------------- the lint

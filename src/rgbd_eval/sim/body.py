@@ -825,7 +825,7 @@ _WALK_FK = (
 
 
 #: Phases per cycle of the foot-lock table and of the posed-vertex cache; strides cached.
-LOCK_SAMPLES = 96
+LOCK_SAMPLES = 32
 VERTEX_PHASES = 32
 WALK_TABLES = 4
 #: A sole vertex touches the floor when it is this low (metres).

@@ -167,6 +167,9 @@ PATTERN_SCALE = {"stripes": 52.0, "check": 28.0, "dots": 40.0, "weave": 400.0}
 
 #: Walk cycle phases posed per stride (the rest interpolated).
 PHASES = 32
+#: Slower than this (m/s) nobody walks steadily (people's slowest comfortable walk is about
+#: 0.6 m/s): see :meth:`Dressed.stride`.
+SLOWEST_WALK = 0.5
 
 
 @dataclass(frozen=True)
@@ -363,8 +366,13 @@ class Dressed:
     _fixed: dict[str, F64] = field(default_factory=dict, repr=False, compare=False)
 
     def stride(self, speed: float) -> float:
-        """Metres per gait cycle at ``speed`` m/s, to the centimetre (few tables per person)."""
-        return round(natural_stride(self.body, max(speed, 0.3)), 2)
+        """Metres per gait cycle at ``speed`` m/s, to the centimetre (few tables per person).
+
+        Below SLOWEST_WALK m/s a person is starting or stopping: the gait fades into standing
+        (its amplitude), and the stride of an ordinary walk (1.2 m/s) serves, rather than a
+        walk table of its own for a few frames.
+        """
+        return round(natural_stride(self.body, speed if speed >= SLOWEST_WALK else 1.2), 2)
 
     def _posed(self, pose: BodyPose) -> NDArray[np.float32]:
         """Vertices and vertex normals (2, V, 3) in ``pose``, body frame."""
@@ -478,7 +486,8 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
     normals = vertex_normals(v, model.faces)
 
     def label(*which: str) -> NDArray[np.bool_]:
-        return np.isin(lab, [label_names.index(w) for w in which]) & body_v
+        out: NDArray[np.bool_] = np.isin(lab, [label_names.index(w) for w in which]) & body_v
+        return out
 
     # where each vertex lies along its limb
     arm = np.zeros(n)
@@ -576,8 +585,8 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
     col[wear == HAIR] = look.hair
     # eyes: white, iris and pupil facing forward
     eye_groups = [names.index("helper-l-eye"), names.index("helper-r-eye")]
-    for k, g in enumerate(eye_groups):
-        idx = np.unique(model.faces[model.face_group == g])
+    for k, group in enumerate(eye_groups):
+        idx = np.unique(model.faces[model.face_group == group])
         d = v[idx] - marks.eye[k]
         forward = d[:, 0] / np.maximum(exact.norm(d), 1e-9)
         c = np.where(
@@ -586,9 +595,9 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
             np.where(forward[:, None] > 0.86, np.asarray(look.iris, dtype=np.float64), 225.0),
         )
         col[idx] = c
-    for g in names:
-        if "eyelashes" in g:
-            col[np.unique(model.faces[model.face_group == names.index(g)])] = (20.0, 18.0, 16.0)
+    for name in names:
+        if "eyelashes" in name:
+            col[np.unique(model.faces[model.face_group == names.index(name)])] = (20.0, 18.0, 16.0)
 
     # --- the triangles shown
     keep = np.isin(model.face_group, [0, *eye_groups]) | np.array(
@@ -617,13 +626,13 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
     pattern = np.zeros(len(faces), dtype=np.int32)
     colour2 = corner[:, 0].copy()
     scale = np.ones(len(faces))
-    for code, g in ((TOP, top), (BOTTOM, bottom)):
-        if g is None or g.pattern == "plain":
+    for code, worn in ((TOP, top), (BOTTOM, bottom)):
+        if worn is None or worn.pattern == "plain":
             continue
         sel = t_wear == code
-        pattern[sel] = PATTERN_CODES[g.pattern]
-        colour2[sel] = g.colour2
-        scale[sel] = PATTERN_SCALE[g.pattern]
+        pattern[sel] = PATTERN_CODES[worn.pattern]
+        colour2[sel] = worn.colour2
+        scale[sel] = PATTERN_SCALE[worn.pattern]
     uv = model.face_uv[keep].astype(np.float64)
     materials = np.where(t_wear == SKIN, MAT_SKIN, MAT_MATTE).astype(np.int32)
     surface = Surface(corner, uv, pattern, colour2, scale)

@@ -114,7 +114,7 @@ def _cast_into(
     the rays of cell ``k = row * width + col`` are ``cell_rays[cell_start[k]:cell_start[k+1]]``.
     A hit counts when ``near_t < t < t_max[ray]`` (``near_t`` = ``grid[4]`` times the ray's z).
     """
-    fx, fy, cx, cy, near = grid[0], grid[1], grid[2], grid[3], grid[4]
+    near = grid[4]
     gw, gh = grid_size[0], grid_size[1]
     poly = np.empty((4, 2))
     for k in range(triangles.shape[0]):
@@ -125,11 +125,19 @@ def _cast_into(
         in_a, in_b, in_c = a[2] >= near, b[2] >= near, c[2] >= near
         if not (in_a or in_b or in_c):
             continue
-        n = _polygon(a, b, c, projected, (ia, ib, ic), grid, poly)
-        bu0 = min(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
-        bu1 = max(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
-        bv0 = min(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
-        bv1 = max(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
+        whole = in_a and in_b and in_c
+        if whole:  # wholly ahead: the corners' projections bound it
+            n = 3
+            bu0 = min(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bu1 = max(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bv0 = min(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+            bv1 = max(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+        else:
+            n = _polygon(a, b, c, projected, (ia, ib, ic), grid, poly)
+            bu0 = min(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
+            bu1 = max(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
+            bv0 = min(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
+            bv1 = max(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
         # the cells [i - 1/2, i + 1/2) the box touches (a pixel's ray lies at its cell's
         # centre); 1e-6 of a cell more on each side for the rounding of the projections
         if bu1 < -1.0 or bv1 < -1.0 or bu0 > gw or bv0 > gh:
@@ -140,6 +148,13 @@ def _cast_into(
         j1 = min(int(np.floor(bv1 + 0.5 + 1e-6)), gh - 1)
         if i0 > i1 or j0 > j1:
             continue
+        # a large box: test only the cells each row of the triangle reaches (not worth it
+        # for the few cells of a small one)
+        wide = (i1 - i0 + 1) * (j1 - j0 + 1) > 32 and j1 > j0
+        if wide and whole:
+            for m, corner in enumerate((ia, ib, ic)):
+                poly[m, 0] = projected[corner, 0]
+                poly[m, 1] = projected[corner, 1]
         e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
         e2x, e2y, e2z = c[0] - a[0], c[1] - a[1], c[2] - a[2]
         # the ray origin is the frame's origin: tvec = -a
@@ -151,7 +166,7 @@ def _cast_into(
         for j in range(j0, j1 + 1):
             row = j * gw
             r0, r1 = i0, i1
-            if j1 > j0:  # only the cells of this row the triangle reaches
+            if wide:  # only the cells of this row the triangle reaches
                 su0, su1, inside = _row_span(poly, n, j - 0.5 - 1e-6, j + 0.5 + 1e-6)
                 if not inside:
                     continue

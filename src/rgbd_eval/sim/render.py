@@ -101,6 +101,37 @@ def _camera_rays(
     return d, cells
 
 
+def _gather(
+    triangle: I32,
+    t: F64,
+    u: F64,
+    v: F64,
+    face_normals: F32,
+    depth: F32,
+    uv: F32,
+    normals: F32,
+) -> None:
+    """Per ray: depth (NaN: no hit), barycentrics and the hit triangle's normal (0: none),
+    as float32 (each value rounded once, as numpy's casts do)."""
+    for i in range(triangle.shape[0]):
+        k = triangle[i]
+        uv[i, 0] = u[i]
+        uv[i, 1] = v[i]
+        if k >= 0:
+            depth[i] = t[i]
+            normals[i, 0] = face_normals[k, 0]
+            normals[i, 1] = face_normals[k, 1]
+            normals[i, 2] = face_normals[k, 2]
+        else:
+            depth[i] = np.nan
+            normals[i, 0] = 0.0
+            normals[i, 1] = 0.0
+            normals[i, 2] = 0.0
+
+
+_gather_kernel: Callable[..., None] = numba.njit(cache=True)(_gather)
+
+
 class CameraCast:
     """One camera's pixel rays from a pose, with the nearest hits cast so far."""
 
@@ -131,11 +162,13 @@ class CameraCast:
         """The hits so far; ``face_normals`` (T, 3) of every triangle id that was cast."""
         b = self._bundle
         h, w = self.camera.height, self.camera.width
-        hit = b.triangle >= 0
-        depth = np.where(hit, b.t, np.nan).astype(np.float32)
-        uv = np.stack([b.u, b.v], axis=1).astype(np.float32)
-        normals = np.zeros((len(hit), 3), dtype=np.float32)
-        normals[hit] = face_normals[b.triangle[hit]]
+        n = len(b.triangle)
+        depth = np.empty(n, dtype=np.float32)
+        uv = np.empty((n, 2), dtype=np.float32)
+        normals = np.empty((n, 3), dtype=np.float32)
+        _gather_kernel(
+            b.triangle, b.t, b.u, b.v, np.ascontiguousarray(face_normals), depth, uv, normals
+        )
         return Hits(
             depth.reshape(h, w),
             b.triangle.reshape(h, w),
@@ -384,7 +417,9 @@ def shade(
         detailed = np.flatnonzero(_lookup(mesh.surface.detailed(), tri))
         if detailed.size:
             t = tri[detailed]
-            colour[detailed] = surface_colours(mesh.surface, t, bary[detailed], colour[detailed])
+            colour[detailed] = surface_colours(
+                mesh.surface, t, bary[detailed], colour[detailed].astype(np.float64)
+            )
     wall = np.flatnonzero(_lookup(mesh.materials == MAT_WALL, tri))
     if wall.size:
         d_wall = hits.directions.reshape(-1, 3)[wall]

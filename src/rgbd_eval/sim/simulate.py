@@ -218,7 +218,11 @@ class Simulator:
         clean = shade(mesh, hits, self.light, sc.room.floor_tile, casters)
         if s.rgb_blur_px > 0.0:  # the lens and the Bayer demosaic soften the image
             clean = np.stack(
-                [exact.gaussian_filter(clean[..., k], s.rgb_blur_px) for k in range(3)], axis=-1
+                [
+                    exact.gaussian_filter(clean[..., k].astype(np.float64), s.rgb_blur_px)
+                    for k in range(3)
+                ],
+                axis=-1,
             ).astype(np.float32)
         ids = object_ids(mesh, hits)
         gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s) * s.illumination
