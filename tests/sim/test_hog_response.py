@@ -3,9 +3,9 @@
 Issue 30 compares with real people: on PCL's ``five_people`` Kinect frame (2-3 m) the authors'
 classifier (seed 000, 5.4.2; PCL's C++ model) gives +0.77, +0.40, 0.00, +0.11 and -0.96
 (median +0.11). Our fully visible walkers at 3-4 m score higher than that median (about
-+0.6, every orientation and person pooled; the profiles lowest): the guard here is the lower
++0.7, every orientation and person pooled; the profiles lowest): the guard here is the lower
 side, that they stay at least as person-like as the real people (the mannequins they replace
-scored about -1.3), and that person-sized objects (coat stand, plant, cabinet) score well
+scored about -1.0), and that person-sized objects (coat stand, plant, cabinet) score well
 below them. ``tools/realism/measure.py`` reports the whole grid (distances, orientations,
 SSDLite, OpenCV's HOG).
 """
