@@ -18,6 +18,7 @@ OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
 #: Flags that belong to other programs quoted in the README (pip, pytest, dask, rerun, chromium).
 FOREIGN = {"--no-deps", "--upgrade", "--strict-markers", "--nworkers", "--nthreads"}
 FOREIGN |= {"--headless", "--web-viewer", "--use-angle", "--enable-unsafe-swiftshader"}
+FOREIGN |= {"--people"}  # tools/realism/measure.py
 
 
 def _options() -> dict[str, set[str]]:
