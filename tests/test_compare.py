@@ -167,3 +167,72 @@ def test_cli_prints_the_note_and_gates_on_the_metrics(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     assert "note: sequence 'demo': the recordings differ in bytes" in result.stderr
     assert "Notes:" in (tmp_path / "c.md").read_text()
+
+
+# ----------------------------------------------------------------------------- significance
+
+TUD = Path(pytest.importorskip("motmetrics").__file__).parent / "data" / "TUD-Campus"
+
+
+def _scored(tmp_path: Path, name: str, keep: Any = None) -> Path:
+    """`rgbd-eval score` of TUD-Campus' tracker output (rows kept by ``keep``) into a folder."""
+    rows = (TUD / "test.txt").read_text().splitlines()
+    tracks = tmp_path / name / "TUD-Campus.txt"  # the sequence is named after the file
+    tracks.parent.mkdir()
+    tracks.write_text("\n".join(r for r in rows if keep is None or keep(r)) + "\n")
+    out = tmp_path / name / "out"
+    result = runner.invoke(
+        app, ["score", str(tracks), "--gt", str(TUD / "gt.txt"), "--out", str(out)]
+    )
+    assert result.exit_code == 0, result.output
+    return out
+
+
+def _track_id(row: str) -> int:
+    return int(row.split(",")[1])
+
+
+def test_significance_tells_a_real_change_from_noise(tmp_path: Path) -> None:
+    base = _scored(tmp_path, "base")
+    # Track 4's last row gone: one miss more, MOTA 0.28 pp lower, in one frame of 71.
+    one = _scored(tmp_path, "one", lambda r: not r.startswith("37,4,"))
+    # Tracks 3 and 6 gone: misses in many frames.
+    many = _scored(tmp_path, "many", lambda r: _track_id(r) not in (3, 6))
+    strict = ["--tolerance", "mota=0"]
+    result = runner.invoke(app, ["compare", str(base), str(one), *strict])
+    assert result.exit_code == 1 and "TUD-Campus/mota" in result.stderr  # beyond tolerance 0
+    result = runner.invoke(app, ["compare", str(base), str(one), *strict, "--significance"])
+    assert result.exit_code == 0, result.output  # within the noise of its frames
+    assert "(noise)" in result.stdout
+    result = runner.invoke(app, ["compare", str(base), str(many), "--significance"])
+    assert result.exit_code == 1 and "regression(s) beyond noise" in result.stderr
+    assert "(beyond noise)" in result.stdout
+
+
+def test_reports_without_frame_tables_compare_on_the_tolerance(tmp_path: Path) -> None:
+    base = _scored(tmp_path, "base")
+    cur = _scored(tmp_path, "cur", lambda r: _track_id(r) not in (3, 6))
+    (cur / "TUD-Campus.frames.npz").unlink()
+    result = runner.invoke(app, ["compare", str(base), str(cur), "--significance"])
+    # MOTA falls by more than its 1 pp tolerance: a regression, gated as without intervals.
+    assert result.exit_code == 1 and "TUD-Campus/mota" in result.stderr
+    assert "no intervals (current report without its TUD-Campus.frames.npz)" in result.stdout
+    # A report from before the tables (no frames_file key) compares the same way.
+    report_json = cur / "report.json"
+    data = json.loads(report_json.read_text())
+    del data["sequences"][0]["frames_file"]
+    old = tmp_path / "old.json"
+    old.write_text(json.dumps(data))
+    result = runner.invoke(app, ["compare", str(base), str(old), "--significance"])
+    assert result.exit_code == 1 and "no intervals" in result.stdout
+    # One line on stderr: the error (the note on the gate is with the table).
+    assert result.stderr.count("\n") == 1
+
+
+def test_a_frame_table_that_changed_is_refused(tmp_path: Path) -> None:
+    base = _scored(tmp_path, "base")
+    cur = _scored(tmp_path, "cur")
+    table = cur / "TUD-Campus.frames.npz"
+    table.write_bytes(table.read_bytes() + b"\0")
+    result = runner.invoke(app, ["compare", str(base), str(cur)])
+    assert result.exit_code == 2 and "changed since the report was written" in result.stderr

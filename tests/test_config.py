@@ -81,6 +81,12 @@ def test_overrides_are_typed() -> None:
             r"IoU threshold=1.5 must be in \(0, 1\]",
         ),
         ({"detector": {"ground_mode": "points"}}, "ground_mode 'points' needs"),
+        # Sizes of the bootstrap's arrays (replicates x columns): bounded, as other sizes are.
+        (
+            {"evaluation": {"bootstrap_replicates": 10**9}},
+            r"allowed: 0 <= bootstrap_replicates <= 100000",
+        ),
+        ({"evaluation": {"distance_bands": list(range(1, 200))}}, r"at most 50 items"),
     ],
 )
 def test_invalid_values_are_named(data: dict[str, object], match: str) -> None:

@@ -92,7 +92,10 @@ LAYERS = [
         ],
     ),
     ("experiments of reproduce", ["rgbd_eval.methods.*.experiments"]),
-    ("report", ["rgbd_eval.report", "rgbd_eval.report.*", "rgbd_eval.compare"]),
+    (
+        "report",
+        ["rgbd_eval.report", "rgbd_eval.report.*", "rgbd_eval.compare", "rgbd_eval.significance"],
+    ),
     ("cli", ["rgbd_eval.cli", "rgbd_eval.cli.*", "rgbd_eval.__main__"]),
 ]
 

@@ -1,4 +1,12 @@
-"""Compare two run reports: what got better, what got worse, what regressed beyond tolerance."""
+"""Compare two run reports: what got better, what got worse, what regressed beyond tolerance.
+
+Where both reports have their per-frame tables (``<name>.frames.npz`` beside
+``report.json``), each change also gets the 95 % interval of a paired block bootstrap
+(:func:`rgbd_eval.significance.paired_intervals`): the same resampled frames of the same
+sequence in both reports. A change whose interval excludes 0 is beyond noise;
+``significance`` gates on that instead of the fixed tolerance (metrics without an interval
+keep their tolerance).
+"""
 
 from __future__ import annotations
 
@@ -60,12 +68,21 @@ class Delta:
     current: float | None
     tolerance: float
     status: Status
+    #: The 95 % interval of the change (current - baseline) by the paired bootstrap.
+    interval: tuple[float, float] | None = None
 
     @property
     def change(self) -> float | None:
         if self.baseline is None or self.current is None:
             return None
         return self.current - self.baseline
+
+    @property
+    def beyond_noise(self) -> bool | None:
+        """Whether the change's interval excludes 0 (None without an interval)."""
+        if self.interval is None:
+            return None
+        return not self.interval[0] <= 0.0 <= self.interval[1]
 
 
 @dataclass(frozen=True)
@@ -74,6 +91,13 @@ class Comparison:
     config_changes: tuple[str, ...]
     #: What a reader must know besides the deltas (recordings of one provenance that differ).
     notes: tuple[str, ...] = ()
+    #: Whether metrics with an interval were gated on it (``--significance``).
+    significance: bool = False
+
+    @property
+    def gate(self) -> str:
+        """What a regression is beyond, in words."""
+        return "noise or tolerance" if self.significance else "tolerance"
 
     @property
     def regressions(self) -> tuple[Delta, ...]:
@@ -185,7 +209,15 @@ def parse_tolerances(items: list[str]) -> dict[str, float]:
     return out
 
 
-def _status(base: float | None, cur: float | None, better: Better, tol: float) -> Status:
+def _status(
+    base: float | None,
+    cur: float | None,
+    better: Better,
+    tol: float,
+    interval: tuple[float, float] | None = None,
+) -> Status:
+    """The status of one change: against ``tol``, or with ``interval`` (significance
+    gating) against the noise: worse and beyond noise regresses."""
     if base is None or cur is None:
         if base is None:
             return Status.SAME if cur is None else Status.NEW
@@ -195,6 +227,8 @@ def _status(base: float | None, cur: float | None, better: Better, tol: float) -
         return Status.SAME
     if gain > 0:
         return Status.BETTER
+    if interval is not None:
+        return Status.REGRESSED if not interval[0] <= 0.0 <= interval[1] else Status.WORSE
     return Status.REGRESSED if -gain > tol + 1e-12 else Status.WORSE
 
 
@@ -211,9 +245,17 @@ def compare_reports(
     baseline: Mapping[str, Any],
     current: Mapping[str, Any],
     tolerances: Mapping[str, float] | None = None,
+    intervals: Mapping[tuple[str, str], tuple[float, float]] | None = None,
+    significance: bool = False,
 ) -> Comparison:
-    """Per sequence and overall deltas; CompareInputError when the reports are not comparable."""
+    """Per sequence and overall deltas; CompareInputError when the reports are not comparable.
+
+    ``intervals`` maps ``(sequence or 'overall', metric)`` to the 95 % interval of the
+    change (:func:`rgbd_eval.significance.paired_intervals`); with ``significance`` a metric
+    that has one regresses when worse beyond noise, whatever its tolerance.
+    """
     tolerances = dict(tolerances or {})
+    intervals = dict(intervals or {})
     base_seqs = {s["name"]: s for s in baseline["sequences"]}
     cur_seqs = {s["name"]: s for s in current["sequences"]}
     if set(base_seqs) != set(cur_seqs):
@@ -261,7 +303,9 @@ def compare_reports(
             tol = tolerances.get(metric, default_tol)
             b = None if base is None else base.get(metric)
             c = None if cur is None else cur.get(metric)
-            deltas.append(Delta(seq, metric, b, c, tol, _status(b, c, better, tol)))
+            interval = intervals.get((seq, metric))
+            gate = interval if significance else None
+            deltas.append(Delta(seq, metric, b, c, tol, _status(b, c, better, tol, gate), interval))
         for metric in sorted(set(base or {}) - set(DEFAULT_TOLERANCES)):
             b, c = (base or {})[metric], (cur or {}).get(metric)
             if b is not None and c is None:  # not gated by value, but must not vanish
@@ -275,7 +319,7 @@ def compare_reports(
         for k in sorted(set(flat_b) | set(flat_c))
         if flat_b.get(k) != flat_c.get(k)
     )
-    return Comparison(tuple(deltas), changes, tuple(notes))
+    return Comparison(tuple(deltas), changes, tuple(notes), significance)
 
 
 def _same_recording(
@@ -338,6 +382,18 @@ def _fmt(value: float | None, metric: str) -> str:
     return f"{value:g}"
 
 
+def _interval_text(d: Delta) -> str:
+    """``[-1.20, +0.30] pp (noise)``: the change's interval and whether it excludes 0."""
+    if d.interval is None:
+        return "-"
+    percent = _fmt(0.0, d.metric).endswith("%")
+    scale = 100.0 if percent else 1.0
+    lo, hi = (scale * v for v in d.interval)
+    digits = ".2f" if percent else (".4f" if d.metric == "motp" else "g")
+    text = f"[{lo:+{digits}}, {hi:+{digits}}]" + (" pp" if percent else "")
+    return f"{text} ({'beyond noise' if d.beyond_noise else 'noise'})"
+
+
 def table_rows(comparison: Comparison, changed_only: bool = False) -> list[list[str]]:
     rows = []
     for d in comparison.deltas:
@@ -359,22 +415,23 @@ def table_rows(comparison: Comparison, changed_only: bool = False) -> list[list[
                 _fmt(d.baseline, d.metric),
                 _fmt(d.current, d.metric),
                 shown,
+                _interval_text(d),
                 d.status.value,
             ]
         )
     return rows
 
 
-HEADER = ["sequence", "metric", "baseline", "current", "change", "status"]
+HEADER = ["sequence", "metric", "baseline", "current", "change", "95% interval", "status"]
 
 
 def markdown(comparison: Comparison) -> str:
     lines = ["| " + " | ".join(HEADER) + " |", "|" + "|".join("---" for _ in HEADER) + "|"]
     lines += ["| " + " | ".join(r) + " |" for r in table_rows(comparison)]
     verdict = (
-        f"**{len(comparison.regressions)} regression(s)** beyond tolerance."
+        f"**{len(comparison.regressions)} regression(s)** beyond {comparison.gate}."
         if comparison.regressions
-        else "No regression beyond tolerance."
+        else f"No regression beyond {comparison.gate}."
     )
     lines += ["", verdict]
     if comparison.config_changes:

@@ -12,6 +12,7 @@ dotted keys::
 from __future__ import annotations
 
 import enum
+import itertools
 import math
 import os
 from collections.abc import Iterable, Mapping, Sequence
@@ -153,6 +154,26 @@ class EvaluationConfig(_Model):
         Convention.MOTCHALLENGE,
         description="'motchallenge' (devkit/TrackEval) or 'motmetrics' (py-motmetrics 1.4)",
     )
+    # Breakdowns and intervals (rgbd_eval.metrics.breakdowns, rgbd_eval.metrics.bootstrap).
+    distance_bands: list[float] = Field(
+        [2.0, 4.0, 6.0],
+        min_length=1,
+        max_length=50,
+        description="edges (m) of the bands of distance from the camera: 0-2, 2-4, 4-6, 6+",
+    )
+    driving_speed: float = Field(
+        0.1, gt=0.0, description="m/s above which the robot counts as driving"
+    )
+    turning_rate: float = Field(
+        0.2, gt=0.0, description="rad/s (about 11.5 deg/s) above which the robot counts as turning"
+    )
+    bootstrap_replicates: int = Field(
+        1000,
+        ge=0,
+        le=100_000,
+        description="replicates of the block bootstrap behind each interval (0: none)",
+    )
+    bootstrap_seed: int = Field(33, ge=0, description="the seed of the block bootstrap")
 
     def effective_threshold(self) -> float:
         if self.threshold is not None:
@@ -164,6 +185,11 @@ class EvaluationConfig(_Model):
         problem = None if self.threshold is None else threshold_problem(self.gating, self.threshold)
         if problem is not None:
             raise ValueError(problem)
+        edges = self.distance_bands
+        if any(not (0.0 < e < math.inf) for e in edges) or any(
+            b <= a for a, b in itertools.pairwise(edges)
+        ):
+            raise ValueError(f"distance_bands={edges} must be increasing distances > 0 (m)")
         return self
 
 

@@ -20,7 +20,7 @@ from rgbd_eval.io.groundtruth import GroundTruth, load_ground_truth
 from rgbd_eval.io.recording import Recording, RecordingInfo, open_recording
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence
 from rgbd_eval.plugins import detector_spec, streams_of, tracker_spec
-from rgbd_eval.types import Detection, Frame, GroundTruthObject, TrackOutput
+from rgbd_eval.types import Detection, Frame, GroundTruthObject, Pose, TrackOutput
 
 #: Called after each frame with (frames done, frames in all).
 Progress = Callable[[int, int], None]
@@ -31,11 +31,16 @@ TRACK_REST = "track"
 
 @dataclass(frozen=True)
 class SequenceDetections:
-    """The detector's output for every frame of a recording."""
+    """The detector's output for every frame of a recording.
+
+    ``camera_poses``: the camera's world pose of every frame (``Frame.camera_pose``), for
+    the breakdowns by distance and robot motion; empty where not kept (the detection cache).
+    """
 
     stamps_ns: tuple[int, ...]
     detections: tuple[tuple[Detection, ...], ...]
     seconds: dict[str, float] = field(default_factory=dict)
+    camera_poses: tuple[Pose, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -228,6 +233,7 @@ def detect_and_track(
     tracker = create_tracker(config)
     with_frame = needs_frame(config)
     stamps: list[int] = []
+    poses: list[Pose] = []
     per_frame: list[tuple[Detection, ...]] = []
     tracks: list[tuple[TrackOutput, ...]] = []
     for frame, dets in _detect_frames(recording, config, seconds, stages):
@@ -240,12 +246,15 @@ def detect_and_track(
         seconds["track"] += spent
         _add_stages(stages, tracker.last_timings, TRACK_REST, spent)
         stamps.append(frame.stamp_ns)
+        poses.append(frame.camera_pose)
         per_frame.append(
             dets if keep_appearance else tuple(replace(d, appearance=None) for d in dets)
         )
         if progress is not None:
             progress(len(per_frame), len(recording))
-    sequence = SequenceDetections(tuple(stamps), tuple(per_frame), _stage_seconds(seconds, stages))
+    sequence = SequenceDetections(
+        tuple(stamps), tuple(per_frame), _stage_seconds(seconds, stages), tuple(poses)
+    )
     return sequence, tuple(tracks)
 
 

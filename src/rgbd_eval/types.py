@@ -632,7 +632,12 @@ class Detection:
 
 @dataclass(frozen=True)
 class TrackOutput:
-    """A tracker's output for one track in one frame (seed 000, Listing 6.1)."""
+    """A tracker's output for one track in one frame (seed 000, Listing 6.1).
+
+    ``confidence`` is the score the tracker gives the track in this frame, where it has one
+    (basso2012: the HOG confidence of the detection it was updated with; tracker output
+    files: their ``conf`` column); ``score --curve`` and ``run --curve`` sweep a threshold on it.
+    """
 
     track_id: int
     x: float
@@ -641,6 +646,7 @@ class TrackOutput:
     box2d: Box2D | None
     visibility: Visibility
     status: TrackStatus = TrackStatus.VALIDATED
+    confidence: float | None = None
 
 
 @dataclass(frozen=True)
@@ -651,6 +657,9 @@ class TrackerOutput:
     frames: tuple[tuple[int, int, tuple[TrackOutput, ...]], ...]
     num_frames: int | None = None
     """The sequence length when the source states it (MOTChallenge ``seqinfo.ini``)."""
+    sensor_poses: tuple[Pose | None, ...] = ()
+    """Per frame, the world pose of the frame the tracks were published in (a recording's
+    tf), None where unknown; empty when the source has none (text files)."""
 
 
 @dataclass(frozen=True)

@@ -262,3 +262,65 @@ def test_tables_give_fp_and_fn_counts_and_pt(tmp_path: Path) -> None:
     md = (out / "report.md").read_text()
     assert "| FP | FN |" in md and "| MT | PT | ML |" in md
     assert "| 100.0% (2) | 0.0% (0) |" in md
+
+
+def test_score_reports_breakdowns_intervals_and_where_it_fails(tmp_path: Path) -> None:
+    # MOT17 ground truth (frame,id,box,consider,class,visibility): person 1 20 % visible,
+    # person 2 90 %, 30 frames. Tracks (frame,id,box,conf,...): 2 on person 2 in every frame
+    # (conf 0.9), 1 on person 1 in the even frames (conf 0.4), 3 nowhere in frames 1-10 (0.1).
+    gt_rows, track_rows = [], []
+    for f in range(1, 31):
+        gt_rows += [f"{f},1,0,0,20,40,1,1,0.2", f"{f},2,100,0,20,40,1,1,0.9"]
+        track_rows.append(f"{f},2,100,0,20,40,0.9,-1,-1,-1")
+        if f % 2 == 0:
+            track_rows.append(f"{f},1,0,0,20,40,0.4,-1,-1,-1")
+        if f <= 10:
+            track_rows.append(f"{f},3,300,0,20,40,0.1,-1,-1,-1")
+    gt = tmp_path / "gt.txt"
+    gt.write_text("\n".join(gt_rows) + "\n")
+    tracks = tmp_path / "seq.txt"
+    tracks.write_text("\n".join(track_rows) + "\n")
+    out = tmp_path / "out"
+    args = ["score", str(tracks), "--gt", str(gt), "--out", str(out), "--curve"]
+    result = runner.invoke(app, args)
+    assert result.exit_code == 0, result.output
+    report = json.loads((out / "report.json").read_text())
+    seq = report["sequences"][0]
+    lo, hi = seq["intervals"]["mota"]
+    assert lo <= seq["metrics"]["mota"] <= hi and seq["block_length"] >= 1
+    assert report["overall"]["intervals"]["mota"] == seq["intervals"]["mota"]
+    breakdowns = seq["breakdowns"]
+    # Text files carry no camera: distance and motion are not available, and say why.
+    assert not breakdowns["distance"]["available"] and not breakdowns["motion"]["available"]
+    assert "no camera pose" in breakdowns["distance"]["reason"]
+    visibility = {b["band"]: b for b in breakdowns["visibility"]["bands"]}
+    # Person 1 (20 %): 30 instances, missed in the 15 odd frames: MOTA (FP-free) 50 %.
+    low = visibility["0-25 %"]
+    assert (low["counts"]["num_gt"], low["counts"]["fn"], low["counts"]["fp"]) == (30, 15, None)
+    assert low["metrics"]["mota"] == 0.5 and not breakdowns["visibility"]["mota_includes_fp"]
+    assert visibility["75-100 %"]["metrics"]["mota"] == 1.0
+    # Where it fails: the 20 % band, 15 misses in 30 frames.
+    (worst,) = report["analysis"]["where_it_fails"]
+    assert (worst["breakdown"], worst["band"], worst["errors_per_frame"]) == (
+        "visibility",
+        "0-25 %",
+        0.5,
+    )
+    persons = {p["gt_id"]: p for p in seq["persons"]}
+    assert persons[1]["coverage"] == 0.5 and persons[1]["track_ids"] == [1]
+    # Person 1's 14 gaps of one frame all end on track 1 again: recovered.
+    assert seq["gaps"][0] == {"frames": "1", "gaps": 14, "recovered": 14, "rate": 1.0}
+    # The curve at the three confidences present: 0.1 keeps everything, 0.4 drops the FPs,
+    # 0.9 also person 1's track.
+    curve = report["analysis"]["curve"]
+    assert [p["threshold"] for p in curve["points"]] == [0.1, 0.4, 0.9]
+    assert [p["metrics"]["fp"] for p in curve["points"]] == [10, 0, 0]
+    assert curve["best"]["mota"] == 0.4
+    named = seq["frames_file"]["name"]
+    assert named == "seq.frames.npz" and (out / named).is_file()
+    md = (out / "report.md").read_text()
+    for section in ("## Where it fails", "## Intervals", "### Visibility", "## Per person"):
+        assert section in md
+    assert "## Confidence threshold curve" in md
+    html = (out / "report.html").read_text()
+    assert html.index("Where it fails") < html.index("<h2>Metrics</h2>")

@@ -720,6 +720,15 @@ def _score_cases() -> list[Case]:
             3,
             "line 2",
         ),
+        Case(
+            "score_tracks_csv_conf_nan",  # a NaN confidence would be dropped at every threshold
+            "SILENT",
+            tracks_file(
+                "t.csv", header.replace(b",x,", b",conf,x,") + b"1,7,0,0,10,10,nan,1,1,1,0\n"
+            ),
+            3,
+            "confidence nan is not finite",
+        ),
         Case("score_tracks_fifo", "HANG", tracks_fifo, 3, "named pipe"),
         Case("score_out_is_file", "TRACEBACK", score_into(a_file), 7, "not a folder"),
         Case("score_out_foreign_folder", "DATA-LOSS", score_into(foreign), 7, "--force"),
@@ -883,6 +892,16 @@ def _ownership_cases() -> list[Case]:
 
         return build
 
+    def score_into_users(*names: str) -> Callable[[Path], list[str]]:
+        def build(root: Path) -> list[str]:
+            mine(root, *(f"out/{n}" for n in names))
+            (root / "t.txt").write_text(MOT_TRACKS)
+            (root / "g.txt").write_text(MOT_GT)
+            args = ["score", str(root / "t.txt"), "--gt", str(root / "g.txt")]
+            return [*args, "--out", str(root / "out"), "--force"]
+
+        return build
+
     def run_into_sweep_folder(root: Path) -> list[str]:
         rec = good_recording(root)
         first = run_isolated(two_point_sweep(rec, root / "res"), root)
@@ -978,6 +997,22 @@ def _ownership_cases() -> list[Case]:
             7,
             "rec.tracks.csv",
             kept("out/rec.tracks.csv"),
+        ),
+        Case(
+            "out_force_user_frames_npz",
+            "DATALOSS",
+            run_into_users("rec.frames.npz", force=True),
+            7,
+            "rec.frames.npz",
+            kept("out/rec.frames.npz"),
+        ),
+        Case(
+            "out_force_score_user_frames_npz",
+            "DATALOSS",
+            score_into_users("t.frames.npz"),
+            7,
+            "t.frames.npz",
+            kept("out/t.frames.npz"),
         ),
         Case(
             "out_run_into_sweep_folder",

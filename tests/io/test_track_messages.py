@@ -200,6 +200,15 @@ def test_each_type_round_trips(tmp_path: Path, msgtype: str, suffix: str) -> Non
         assert first[0].height == pytest.approx(1.8)
 
 
+def test_the_tracks_frame_gives_the_sensor_pose(tmp_path: Path) -> None:
+    bag = tmp_path / "tracks.mcap"
+    _write(bag, SPENCER_TYPE)
+    poses = read_bag_tracks(bag).sensor_poses
+    assert [p.translation if p else None for p in poses] == [SHIFT, SHIFT]
+    # Tracks published in the world frame itself: no sensor pose.
+    assert read_bag_tracks(_write_in(tmp_path / "odom.bag", "odom")).sensor_poses == (None, None)
+
+
 def test_topic_must_be_chosen_when_several(tmp_path: Path) -> None:
     path = tmp_path / "two.mcap"
     with RecordingWriter(path) as w:
@@ -231,13 +240,23 @@ def test_score_a_bag_against_world_ground_truth(tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     import json
 
-    counts = json.loads((out / "report.json").read_text())["sequences"][0]["counts"]
+    sequence = json.loads((out / "report.json").read_text())["sequences"][0]
+    counts = sequence["counts"]
     assert (counts["num_matches"], counts["fp"], counts["fn"], counts["id_switches"]) == (
         4,
         0,
         0,
         0,
     )
+    # The tracks' frame, base_link, is the sensor: at (1, 2) in odom by the tf. Person 0 is
+    # 1 then 1.5 m from it, person 10 hypot(4, 1) = 4.1 then 4.6 m: two instances in 0-2 m,
+    # two in 4-6 m; the static tf: standing.
+    distance = {
+        b["band"]: b["counts"]["num_gt"] for b in sequence["breakdowns"]["distance"]["bands"]
+    }
+    assert distance == {"0-2 m": 2, "2-4 m": 0, "4-6 m": 2, "6+ m": 0}
+    motion = {b["band"]: b["counts"]["frames"] for b in sequence["breakdowns"]["motion"]["bands"]}
+    assert motion == {"standing": 2, "turning": 0, "driving": 0}
 
 
 def _world_gt(path: Path) -> Path:

@@ -131,6 +131,29 @@ def test_run_page_content(pages: dict[str, Path], run_dir: Path) -> None:
     assert shots == sorted(shots, key=int)
 
 
+def test_run_page_shows_where_it_fails_intervals_and_breakdowns(
+    pages: dict[str, Path], run_dir: Path
+) -> None:
+    import json
+
+    html = pages["run"].read_text()
+    report = json.loads((run_dir / "report.json").read_text())
+    seq = report["sequences"][0]
+    # A run has the camera's pose from odometry and tf: every breakdown is available.
+    for kind in ("distance", "visibility", "motion"):
+        assert seq["breakdowns"][kind]["available"], kind
+    assert (run_dir / seq["frames_file"]["name"]).is_file()
+    # "Where it fails" opens the page; the analysis follows the metrics table.
+    assert html.index('id="where-it-fails"') < html.index("<h2>Run</h2>")
+    metrics = html.index("<h2>Metrics</h2>")
+    assert metrics < html.index('id="intervals"') < html.index('id="breakdowns"')
+    for title in ("Distance from the camera", "Visibility of the person", "Robot motion"):
+        assert f"<h3>{title}</h3>" in html
+    assert 'alt="metrics per band of each breakdown"' in html
+    lo, hi = seq["intervals"]["mota"]
+    assert f"[{100 * lo:.1f}, {100 * hi:.1f}]" in html
+
+
 def test_run_page_without_ground_truth_shows_the_tracks_on_the_camera_image(
     pages: dict[str, Path], unscored_dir: Path
 ) -> None:
@@ -182,7 +205,11 @@ def test_score_page_shows_the_errors_of_recorded_tracks(pages: dict[str, Path]) 
     # MOTA = 1 - 3/4 = 25.0%; no world positions, so no bird's-eye plot and no images.
     assert "<td>25.0%</td>" in html
     assert "bird&#39;s-eye" not in html and "image/jpeg" not in html
-    assert html.count("<img ") == 1  # the error timeline
+    # The error timeline; the others are the analysis' plots (intervals, gap recovery).
+    assert html.count('alt="errors per frame of') == 1
+    assert html.count("<img ") == 1 + html.count('alt="metrics with their') + html.count(
+        'alt="recovery rate'
+    )
     assert not (pages["score"].parent / "tracks.birdseye.png").exists()
 
 

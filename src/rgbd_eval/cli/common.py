@@ -198,6 +198,18 @@ ConfigOption = Annotated[Path | None, typer.Option("--config", help="YAML run co
 SetOption = Annotated[
     list[str] | None, typer.Option("--set", help="KEY=VALUE config override, repeatable")
 ]
+#: ``rgbd_eval.metrics.curves.DEFAULT_POINTS`` (not imported: the CLI loads metrics lazily).
+DEFAULT_CURVE_POINTS = 20
+CurveOption = Annotated[
+    bool,
+    typer.Option(
+        "--curve", help="also score at each confidence threshold present: the threshold curve"
+    ),
+]
+CurvePointsOption = Annotated[
+    int,
+    typer.Option("--curve-points", min=2, help="thresholds of --curve at most (quantiles beyond)"),
+]
 
 
 def topic_overrides(items: list[str] | None) -> list[str]:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -28,6 +29,14 @@ def compare(
     html_file: Annotated[
         Path | None, typer.Option("--html", help="also write the deltas as an HTML page")
     ] = None,
+    significance: Annotated[
+        bool,
+        typer.Option(
+            "--significance",
+            help="a metric regresses when worse beyond its 95% paired-bootstrap interval "
+            "(instead of its tolerance; needs the reports' <name>.frames.npz)",
+        ),
+    ] = False,
 ) -> None:
     """Per sequence and overall, what got better and what got worse; exit 1 on regression."""
     from rgbd_eval.compare import (  # heavy (report -> metrics -> motmetrics/pandas): only here
@@ -39,13 +48,18 @@ def compare(
         parse_tolerances,
         table_rows,
     )
+    from rgbd_eval.significance import paired_intervals
 
     tolerances = parse_tolerances(tolerance or [])  # bad arguments fail before any file is read
     inputs = [baseline, baseline / "report.json", current, current / "report.json"]
     for output in (markdown_file, html_file):
         if output is not None:  # before the reports are read; never one of them
             check_output_file(output, "compare", inputs)
-    comparison = compare_reports(load_report(baseline), load_report(current), tolerances)
+    base_report, cur_report = load_report(baseline), load_report(current)
+    intervals, missing = paired_intervals(baseline, base_report, current, cur_report)
+    comparison = compare_reports(base_report, cur_report, tolerances, intervals, significance)
+    if significance:  # where there is no interval, say so: those metrics keep their tolerance
+        comparison = replace(comparison, notes=(*comparison.notes, *missing))
     table = Table(title=f"{baseline} -> {current}", title_justify="left")
     for i, head in enumerate(HEADER):
         table.add_column(head, justify="left" if i < 2 else "right")
@@ -62,7 +76,10 @@ def compare(
     for change in comparison.config_changes:
         console.print(f"config: {change}")
     for note in comparison.notes:
-        typer.echo(f"note: {one_line(note)}", err=True)
+        if note in missing:  # how the gate works, with the table: not a problem of the input
+            console.print(f"note: {one_line(note)}", markup=False, highlight=False)
+        else:
+            typer.echo(f"note: {one_line(note)}", err=True)
     if markdown_file is not None:
         write_text(markdown_file, markdown(comparison), "compare")
     if html_file is not None:
@@ -75,10 +92,10 @@ def compare(
         reasons = []
         if worse:
             names = ", ".join(f"{d.sequence}/{d.metric}" for d in worse)
-            reasons.append(f"{len(worse)} regression(s) beyond tolerance: {names}")
+            reasons.append(f"{len(worse)} regression(s) beyond {comparison.gate}: {names}")
         if lost:
             names = ", ".join(f"{d.sequence}/{d.metric}" for d in lost)
             reasons.append(f"{len(lost)} metric(s) scored in the baseline but missing now: {names}")
         typer.echo(f"error: {one_line('; '.join(reasons))}", err=True)
         raise typer.Exit(1)
-    console.print("no regression beyond tolerance")
+    console.print(f"no regression beyond {comparison.gate}")

@@ -11,7 +11,10 @@ import typer
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
+    DEFAULT_CURVE_POINTS,
     ConfigOption,
+    CurveOption,
+    CurvePointsOption,
     SetOption,
     TopicOption,
     advance_callback,
@@ -130,6 +133,8 @@ def run(
         str | None,
         typer.Option(help=f"{CLUSTER_HELP} (default: in this process for one recording)"),
     ] = None,
+    curve: CurveOption = False,
+    curve_points: CurvePointsOption = DEFAULT_CURVE_POINTS,
     rerun: Annotated[
         Path | None,
         typer.Option(
@@ -141,6 +146,7 @@ def run(
 ) -> None:
     """Run the pipeline on recordings and score it against their ground truth."""
     from rgbd_eval.pipeline import run_sequence, sequence_name  # heavy imports only when needed
+    from rgbd_eval.report.analysis import analyse, inputs_of_run
     from rgbd_eval.report.html.pages import write_run_html
     from rgbd_eval.report.run import REPORT_FILE, sequence_warnings, write_run
 
@@ -171,7 +177,8 @@ def run(
     results: list[SequenceResult] = []
     # What this run will write, checked against what the folder holds before any work.
     names = ["report.md", "report.html"]
-    kinds = ["detections.csv", "tracks.csv", "birdseye.png", *(["overlay.mp4"] if video else [])]
+    kinds = ["detections.csv", "tracks.csv", "birdseye.png", "frames.npz"]
+    kinds += ["overlay.mp4"] if video else []
     for p in recordings:
         names += [f"{sequence_name(p)}.{k}" for k in kinds]
     with OutputFolder(out_dir, REPORT_FILE, force, command="run", names=names) as folder:
@@ -193,6 +200,9 @@ def run(
             with connect(spec, warm_up=warm_up) as client, progress_bar() as bar:
                 task = bar.add_task(f"recordings ({spec.describe()})", total=len(recordings))
                 results = map_ordered(client, run_sequence, args, advance_callback(bar, task))
+        analysis = analyse(
+            inputs_of_run(results), config.evaluation, curve_points if curve else None
+        )
         with progress_bar() as bar:
             task = bar.add_task("report.html" + (" + video" if video else ""), total=None)
             report = write_run(
@@ -200,8 +210,9 @@ def run(
                 results,
                 config,
                 lambda staging, rep: write_run_html(
-                    staging, results, config, rep, video, advance_callback(bar, task)
+                    staging, results, config, rep, video, advance_callback(bar, task), analysis
                 ),
+                analysis,
             )
     if rrd is not None:  # re-reads the recording for its images and depth, as --video does
         with progress_bar() as bar:

@@ -11,7 +11,10 @@ import typer
 
 from rgbd_eval.cli.common import (
     CLUSTER_HELP,
+    DEFAULT_CURVE_POINTS,
     ConfigOption,
+    CurveOption,
+    CurvePointsOption,
     SetOption,
     console,
     err_console,
@@ -67,9 +70,12 @@ def score(
         bool,
         typer.Option(help="write into a non-empty --out folder we did not write (keeps its files)"),
     ] = False,
+    curve: CurveOption = False,
+    curve_points: CurvePointsOption = DEFAULT_CURVE_POINTS,
 ) -> None:
     """Score recorded tracker output against ground truth; write the same report as `run`."""
     from rgbd_eval.io.tracks import Benchmark, sequence_pairs
+    from rgbd_eval.report.analysis import analyse, inputs_of_score
     from rgbd_eval.report.html.pages import write_score_html
     from rgbd_eval.report.scoring import score_sequence, table_rows, write_report
 
@@ -103,14 +109,18 @@ def score(
                 pairs = [(name, t.resolve(), g.resolve()) for name, t, g in pairs]
             with connect(spec, warm_up=warm_up) as client:
                 sequences = map_ordered(client, score_sequence, [(*p, *rest) for p in pairs])
+        analysis = analyse(
+            inputs_of_score(sequences), config.evaluation, curve_points if curve else None
+        )
         report = write_report(
             folder,
             sequences,
             config.evaluation,
             max_gap_ns,
             lambda staging, rep: write_score_html(
-                staging, sequences, rep, config.evaluation.gating
+                staging, sequences, rep, config.evaluation.gating, analysis
             ),
+            analysis,
         )
     if json_out:
         typer.echo(json.dumps(report, indent=2))

@@ -172,6 +172,7 @@ def read_bag_tracks(
             frames.append((_stamp(msg), msg.header.frame_id.lstrip("/"), decoded))
     target, why = _target_frame(world_frame, tf)
     out = []
+    sensor: list[Pose | None] = []
     for index, (stamp, frame_id, decoded) in enumerate(sorted(frames, key=lambda f: f[0])):
         pose: Pose | None = None
         if frame_id != target and any(p is not None for _, p, *_ in decoded):
@@ -195,4 +196,5 @@ def read_bag_tracks(
                 x, y = float(point[0, 0]), float(point[0, 1])
             tracks.append(TrackOutput(track_id, x, y, height, box, vis))
         out.append((index, stamp, tuple(tracks)))
-    return TrackerOutput(f"{path} [{topic}]", tuple(out))
+        sensor.append(pose)  # the tracks' own frame in the world: the sensor, where not the world
+    return TrackerOutput(f"{path} [{topic}]", tuple(out), sensor_poses=tuple(sensor))

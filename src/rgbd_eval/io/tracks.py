@@ -3,7 +3,8 @@
 Tracker output formats (detected from the content):
 
 - MOTChallenge 2D text: ``frame,id,bb_left,bb_top,bb_width,bb_height,conf,x,y,z``
-  (frames from 1; world ``x, y, z`` where they are not ``-1``);
+  (frames from 1; world ``x, y, z`` where they are not ``-1``; ``conf`` as the track's
+  confidence, for ``--curve``);
 - our ``tracks.csv`` (``rgbd-eval run`` writes it; a header line names the columns);
 - KTP text (``<stamp>: id x y w h, ...`` or ``<stamp>: id x y z, ...``).
 
@@ -49,7 +50,14 @@ from rgbd_eval.io.groundtruth import (
     require_objects,
 )
 from rgbd_eval.io.validate import MAX_FRAME, MAX_PIXELS, position_problem
-from rgbd_eval.types import Box2D, GroundTruthObject, TrackerOutput, TrackOutput, Visibility
+from rgbd_eval.types import (
+    Box2D,
+    GroundTruthObject,
+    Pose,
+    TrackerOutput,
+    TrackOutput,
+    Visibility,
+)
 
 
 class Benchmark(enum.Enum):
@@ -81,6 +89,8 @@ class Aligned:
     gt: list[list[GroundTruthObject]]
     tracks: list[list[TrackOutput]]
     unmatched_track_frames: int
+    #: Per frame, the tracks' sensor pose (see :attr:`TrackerOutput.sensor_poses`); empty: none.
+    sensor_poses: tuple[Pose | None, ...] = ()
 
 
 # ----------------------------------------------------------------------------- detection
@@ -204,6 +214,7 @@ def read_mot_tracks(path: Path, text: str | None = None) -> TrackerOutput:
                 height=2.0 * z if world else math.nan,
                 box2d=Box2D(float(row[2]), float(row[3]), float(row[4]), float(row[5])),
                 visibility=Visibility.VISIBLE,
+                confidence=float(row[6]) if row.shape[0] >= 7 and math.isfinite(row[6]) else None,
             )
         )
     frames = tuple((f, 0, tuple(by_frame[f])) for f in sorted(by_frame))
@@ -330,12 +341,14 @@ def track_problem(track: TrackOutput) -> str | None:
             return problem
     if math.isinf(track.height):
         return f"height {track.height} is not finite"
+    if track.confidence is not None and not math.isfinite(track.confidence):
+        return f"confidence {track.confidence} is not finite"
     return None
 
 
 def read_tracks_csv(path: Path, text: str | None = None) -> TrackerOutput:
-    """Our ``tracks.csv``: frame, id, box, world x/y/z, stamp, height, visibility, status
-    (``text``: the file's, when already read)."""
+    """Our ``tracks.csv``: frame, id, box, confidence, world x/y/z, stamp, height,
+    visibility, status (``text``: the file's, when already read)."""
     from rgbd_eval.types import TrackStatus
 
     path = Path(path)
@@ -366,6 +379,7 @@ def read_tracks_csv(path: Path, text: str | None = None) -> TrackerOutput:
                     box2d=None if any(v is None for v in box) else Box2D(*box),  # type: ignore[arg-type]
                     visibility=Visibility[(row.get("visibility") or "visible").upper()],
                     status=TrackStatus(row.get("status") or "validated"),
+                    confidence=_float(row.get("conf")),
                 )
                 problem = frame_problem(frame, stamp) or track_problem(track)
                 if problem is not None:
@@ -495,12 +509,17 @@ def _by_frame_number(gt: GroundTruth, tracks: TrackerOutput, length: int | None)
     first = 0 if length is not None else min(numbers, default=0)
     last = max(max(numbers, default=0), first + length - 1 if length is not None else 0)
     timeline = range(first, last + 1) if numbers or length else range(0)
+    poses: tuple[Pose | None, ...] = ()
+    if tracks.sensor_poses:
+        by_frame = {f: p for (f, _, _), p in zip(tracks.frames, tracks.sensor_poses, strict=True)}
+        poses = tuple(by_frame.get(f) for f in timeline)
     return Aligned(
         stamps_ns=tuple(0 for _ in timeline),
         frame_numbers=tuple(f + gt.first_frame for f in timeline),
         gt=[gt_frames.get(f, []) for f in timeline],
         tracks=[track_frames.get(f, []) for f in timeline],
         unmatched_track_frames=0,
+        sensor_poses=poses,
     )
 
 
@@ -520,14 +539,17 @@ def align(
         return _by_frame_number(gt, tracks, length)
     stamps = np.array([s for _, s, _ in gt.frames], dtype=np.int64)
     out: list[list[TrackOutput]] = [[] for _ in gt.frames]
+    poses: list[Pose | None] = [None for _ in gt.frames]
     taken: set[int] = set()
     unmatched = 0
-    for _, stamp, frame_tracks in tracks.frames:
+    sensor = tracks.sensor_poses or (None,) * len(tracks.frames)
+    for (_, stamp, frame_tracks), pose in zip(tracks.frames, sensor, strict=True):
         j = int(np.searchsorted(stamps, stamp))
         candidates = [k for k in (j - 1, j) if 0 <= k < len(stamps)]
         k = min(candidates, key=lambda c: abs(int(stamps[c]) - stamp))
         if abs(int(stamps[k]) - stamp) <= max_gap_ns and k not in taken:
             out[k] = list(frame_tracks)
+            poses[k] = pose
             taken.add(k)
         else:
             unmatched += 1
@@ -537,6 +559,7 @@ def align(
         gt=[list(objs) for _, _, objs in gt.frames],
         tracks=out,
         unmatched_track_frames=unmatched,
+        sensor_poses=tuple(poses) if tracks.sensor_poses else (),
     )
 
 

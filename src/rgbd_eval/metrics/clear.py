@@ -31,7 +31,7 @@ first match is never an id switch, hence never a recall error.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -40,6 +40,7 @@ from scipy.optimize import linear_sum_assignment
 from rgbd_eval.config import Convention, EvaluationConfig, Gating
 from rgbd_eval.errors import ScoringError
 from rgbd_eval.metrics.counts import Counts, Summary, summarize
+from rgbd_eval.metrics.frames import FrameTable, build_table, empty_table
 from rgbd_eval.metrics.gating import gate, similarity_from_measure
 from rgbd_eval.metrics.hota import hota_counts
 from rgbd_eval.metrics.matching import (
@@ -78,10 +79,12 @@ class FrameEvents:
 
 @dataclass(frozen=True)
 class SequenceScores:
-    """The counts of one sequence and its per-frame events."""
+    """The counts of one sequence, its per-frame events and, with dense ids, the per-frame
+    contributions behind the counts (:class:`~rgbd_eval.metrics.frames.FrameTable`)."""
 
     counts: Counts
     frames: tuple[FrameEvents, ...]
+    table: FrameTable = field(default_factory=empty_table, compare=False, repr=False)
 
     def summary(self) -> Summary:
         """The derived measures (:func:`rgbd_eval.metrics.counts.summarize`)."""
@@ -89,12 +92,13 @@ class SequenceScores:
 
     def placed(self, first: int, total: int) -> SequenceScores:
         """These scores of frames ``first..`` of a ``total``-frame sequence, the frames before
-        and after given empty events (not scored): frame ``k`` here is ``first + k`` there."""
+        and after given empty events (not scored): frame ``k`` here is ``first + k`` there.
+        The per-frame table stays that of the scored frames (its frame ``k`` is ``first + k``)."""
         if first == 0 and len(self.frames) == total:
             return self
         scored = {first + e.frame: replace(e, frame=first + e.frame) for e in self.frames}
         frames = tuple(scored.get(k) or FrameEvents(k, (), (), (), (), ()) for k in range(total))
-        return SequenceScores(self.counts, frames)
+        return SequenceScores(self.counts, frames, self.table)
 
 
 def evaluate_sequence(
@@ -122,14 +126,14 @@ def evaluate_sequence(
     return score_selections(selections, config)
 
 
-def _dense(per_frame: Sequence[Sequence[int]]) -> tuple[list[IntArray], int]:
-    """Per-frame ids as dense indices ``0..K-1`` (in sorted id order), and ``K``."""
+def _dense(per_frame: Sequence[Sequence[int]]) -> tuple[list[IntArray], IntArray]:
+    """Per-frame ids as dense indices ``0..K-1`` (in sorted id order), and the K ids."""
     flat = np.fromiter(
         (i for ids in per_frame for i in ids), dtype=np.int64, count=sum(map(len, per_frame))
     )
     unique, inverse = np.unique(flat, return_inverse=True)
     bounds = np.cumsum([len(ids) for ids in per_frame])[:-1]
-    return np.split(inverse.astype(np.int64), bounds), len(unique)
+    return np.split(inverse.astype(np.int64), bounds), unique
 
 
 def score_selections(
@@ -140,12 +144,14 @@ def score_selections(
     threshold = config.effective_threshold()
     if not selections:
         return SequenceScores(Counts.empty(gating, threshold, convention), ())
-    gts, num_gt = _dense([s.gt_ids for s in selections])
+    gts, gt_ids = _dense([s.gt_ids for s in selections])
+    num_gt = len(gt_ids)
     # Present tracks include the dropped ones; the scored tracks are their subset.
     n = len(selections)
-    both, num_tracks = _dense(
+    both, track_ids = _dense(
         [s.track_ids for s in selections] + [sorted(s.present_track_ids) for s in selections]
     )
+    num_tracks = len(track_ids)
     tracks, present = both[:n], both[n:]
     trackeval = convention is Convention.MOTCHALLENGE
     mc = MotChallengeMatcher(num_gt)
@@ -156,6 +162,10 @@ def score_selections(
     potential: list[IntArray] = []
     matched_gt: list[IntArray] = []
     matched_pairs: list[IntArray] = []
+    matched_tracks: list[IntArray] = []
+    switches: list[np.ndarray] = []
+    recalls: list[np.ndarray] = []
+    matched_values: list[np.ndarray] = []
     frames: list[FrameEvents] = []
     similarity_sum = 0.0
     id_switches = recall_errors = 0
@@ -184,6 +194,10 @@ def score_selections(
         recall_errors += int(recall.sum())
         matched_gt.append(mg)
         matched_pairs.append(mg * num_tracks + mt)
+        matched_tracks.append(mt)
+        switches.append(match.switch)
+        recalls.append(recall)
+        matched_values.append(values)
         frames.append(_frame_events(i, sel, match.rows, match.cols, values, match.switch, recall))
     all_gt = np.concatenate(gts)
     all_matched = np.concatenate(matched_gt)
@@ -198,7 +212,8 @@ def score_selections(
     idtp = _idtp(np.concatenate(potential), num_tracks)
     num_gt_instances = len(all_gt)
     num_track_instances = sum(len(x) for x in tracks)
-    hota = hota_counts(gts, tracks, similarities, num_gt, num_tracks)
+    hota_pairs: list[tuple[int, IntArray, IntArray, np.ndarray]] = []
+    hota = hota_counts(gts, tracks, similarities, num_gt, num_tracks, hota_pairs)
     counts = Counts(
         gating=gating,
         threshold=threshold,
@@ -225,7 +240,20 @@ def score_selections(
         ignored_tracks=sum(len(s.dropped_track_ids) for s in selections),
         hota=hota,
     )
-    return SequenceScores(counts, tuple(frames))
+    table = build_table(
+        gt_ids,
+        track_ids,
+        gts,
+        tracks,
+        matched_gt,
+        matched_tracks,
+        switches,
+        recalls,
+        matched_values,
+        potential,
+        hota_pairs,
+    )
+    return SequenceScores(counts, tuple(frames), table)
 
 
 def _idtp(pair_keys: IntArray, num_tracks: int) -> int:

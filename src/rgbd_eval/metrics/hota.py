@@ -113,8 +113,13 @@ def hota_counts(
     similarity: Sequence[FloatArray],
     num_gt: int,
     num_tracks: int,
+    pairs: list[tuple[int, IntArray, IntArray, FloatArray]] | None = None,
 ) -> HotaCounts:
-    """HOTA sums of one sequence from dense ids and per-frame similarity matrices."""
+    """HOTA sums of one sequence from dense ids and per-frame similarity matrices.
+
+    ``pairs``, when given, receives each frame's assignment as ``(frame, gt, track,
+    similarity)`` (for :mod:`rgbd_eval.metrics.frames`).
+    """
     potential = np.zeros((num_gt, num_tracks))
     gt_count = np.zeros(num_gt)
     track_count = np.zeros(num_tracks)
@@ -132,7 +137,7 @@ def hota_counts(
     loc = np.zeros(_N)
     pair_keys: list[IntArray] = []
     pair_sims: list[FloatArray] = []
-    for g, t, s in zip(gt, tracks, similarity, strict=True):
+    for frame, (g, t, s) in enumerate(zip(gt, tracks, similarity, strict=True)):
         if len(g) == 0 or len(t) == 0:
             fp += len(t)
             fn += len(g)
@@ -151,6 +156,8 @@ def hota_counts(
         loc += np.where(matched, sims[None, :], 0.0).sum(axis=1)
         pair_keys.append(g[rows] * num_tracks + t[cols])
         pair_sims.append(sims)
+        if pairs is not None:
+            pairs.append((frame, g[rows], t[cols], sims))
     ass = np.zeros(_N)
     if pair_keys:
         keys = np.concatenate(pair_keys)

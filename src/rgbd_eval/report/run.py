@@ -13,7 +13,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict
 from importlib import metadata
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgbd_eval import __version__
 from rgbd_eval.config import Convention, Gating, RunConfig, config_to_dict
@@ -22,6 +22,10 @@ from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import Counts, FrameEvents, Summary, summarize, total
 from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.pipeline import SequenceResult
+from rgbd_eval.report import analysis as analysis_report
+
+if TYPE_CHECKING:
+    from rgbd_eval.report.analysis import Analysis
 
 REPORT_SCHEMA_VERSION = 1
 #: The file that marks a run folder as ours (and that ``compare`` reads).
@@ -217,6 +221,14 @@ def report_dict(
     }
 
 
+def sequence_summaries(report: dict[str, Any]) -> dict[str, Any]:
+    """Each sequence's metrics, and the overall row's, by name (for the analysis tables)."""
+    out = {s["name"]: s["metrics"] for s in report["sequences"]}
+    if report.get("overall") is not None:
+        out["overall"] = report["overall"]["metrics"]
+    return out
+
+
 def _csv(rows: Sequence[Sequence[Any]], header: Sequence[str]) -> str:
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
@@ -266,7 +278,8 @@ def detections_csv(r: SequenceResult) -> str:
 
 
 def tracks_csv(r: SequenceResult) -> str:
-    """MOTChallenge-style rows (frame, id, box, conf, x, y, z) plus stamp, height, visibility, status."""
+    """MOTChallenge-style rows (frame, id, box, conf, x, y, z) plus stamp, height, visibility,
+    status; ``conf`` is the track's confidence, empty where the tracker gives none."""
     header = [
         "frame",
         "id",
@@ -292,7 +305,7 @@ def tracks_csv(r: SequenceResult) -> str:
                     i,
                     t.track_id,
                     *box,
-                    -1,
+                    "" if t.confidence is None else _num(t.confidence),
                     _num(t.x),
                     _num(t.y),
                     _num(t.height / 2),
@@ -339,17 +352,21 @@ def write_run(
     results: Sequence[SequenceResult],
     config: RunConfig,
     also: Callable[[Path, dict[str, Any]], None] | None = None,
+    analysis: Analysis | None = None,
 ) -> dict[str, Any]:
     """Write every output of a run into ``out`` (published when complete); return the report.
 
     ``out`` is a folder path, or an :class:`OutputFolder` prepared before the pipeline ran.
     ``also(folder, report)`` writes further outputs (the HTML page and its plots) into the
-    staged folder.
+    staged folder. ``analysis`` (:func:`rgbd_eval.report.analysis.analyse`) adds the breakdowns,
+    intervals and curve to the report, and a ``<name>.frames.npz`` per scored sequence.
     """
     import json
 
     digests = [file_digest(Path(r.path)) for r in results]
     report = report_dict(results, config, digests)
+    if analysis is not None:
+        analysis_report.annotate(report, analysis)
     folder = out if isinstance(out, OutputFolder) else OutputFolder(out, REPORT_FILE, command="run")
     with folder:
         tmp = folder.staging
@@ -360,6 +377,9 @@ def write_run(
                 (tmp / f"{r.name}.events.csv").write_text(
                     events_csv(r.scores.frames, r.detections.stamps_ns), encoding="utf-8"
                 )
+        if analysis is not None:
+            for name, data in analysis_report.frames_files(analysis).values():
+                (tmp / name).write_bytes(data)
         md = [
             f"# rgbd-eval run: {config.method}",
             "",
@@ -371,6 +391,8 @@ def write_run(
         if any(r.scores is not None for r in results):
             md.append(markdown_table(results, config.evaluation.gating))
         md += [f"- {note}" for note in run_notes(results)]
+        if analysis is not None:
+            md += analysis_report.markdown(analysis, sequence_summaries(report))
         (tmp / "report.md").write_text("\n".join(md) + "\n", encoding="utf-8")
         (tmp / REPORT_FILE).write_text(
             json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"

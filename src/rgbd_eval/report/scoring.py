@@ -12,7 +12,7 @@ import json
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgbd_eval import __version__
 from rgbd_eval.config import EvaluationConfig, Gating
@@ -22,6 +22,7 @@ from rgbd_eval.io.tracks import Aligned, Benchmark, align, load_gt, load_tracks
 from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import SequenceScores, evaluate_sequence, summarize, total
 from rgbd_eval.outdir import OutputFolder
+from rgbd_eval.report import analysis as analysis_report
 from rgbd_eval.report.run import (
     COLUMNS,
     MATCHING,
@@ -30,6 +31,9 @@ from rgbd_eval.report.run import (
     format_value,
     library_versions,
 )
+
+if TYPE_CHECKING:
+    from rgbd_eval.report.analysis import Analysis
 
 
 @dataclass(frozen=True)
@@ -150,16 +154,20 @@ def write_report(
     config: EvaluationConfig,
     max_gap_ns: int,
     also: Callable[[Path, dict[str, Any]], None] | None = None,
+    analysis: Analysis | None = None,
 ) -> dict[str, Any]:
     """Write report.json, report.md and one events.csv per sequence into ``folder``'s
     staging folder (prepared before the inputs were read, as ``run`` does), then publish it;
     the caller's ``with folder`` discards the staging folder when this fails.
 
-    ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder.
+    ``also(folder, report)`` writes further outputs (the HTML page) into the staged folder;
+    ``analysis`` adds breakdowns, intervals, the curve and the ``<name>.frames.npz`` files.
     """
-    from rgbd_eval.report.run import table_header
+    from rgbd_eval.report.run import sequence_summaries, table_header
 
     report = report_dict(sequences, config, max_gap_ns)
+    if analysis is not None:
+        analysis_report.annotate(report, analysis)
     header = table_header()
     lines = [
         "# rgbd-eval score",
@@ -173,6 +181,7 @@ def write_report(
         *("| " + " | ".join(row) + " |" for row in table_rows(sequences, config.gating)),
         "",
         *(f"- {s.name}: warning: {w}" for s in sequences for w in s.warnings),
+        *(analysis_report.markdown(analysis, sequence_summaries(report)) if analysis else []),
     ]
     tmp = folder.staging
     for s in sequences:
@@ -180,6 +189,9 @@ def write_report(
             events_csv(s.scores.frames, s.aligned.stamps_ns, s.aligned.frame_numbers),
             encoding="utf-8",
         )
+    if analysis is not None:
+        for name, data in analysis_report.frames_files(analysis).values():
+            (tmp / name).write_bytes(data)
     (tmp / "report.md").write_text("\n".join(lines) + "\n", encoding="utf-8")
     (tmp / "report.json").write_text(
         json.dumps(report, indent=2, allow_nan=False) + "\n", encoding="utf-8"

@@ -409,10 +409,12 @@ class Basso2012Tracker:
                 continue
             box: Box2D | None = None
             visibility = Visibility.NOT_VISIBLE
+            confidence = None
             if t.detection is not None:
                 det = dets[t.detection]
                 box = det.box2d
                 visibility = Visibility.OCCLUDED if det.occluded else Visibility.VISIBLE
+                confidence = det.confidence
             out.append(
                 TrackOutput(
                     track_id=t.track_id,
@@ -422,6 +424,7 @@ class Basso2012Tracker:
                     box2d=box,
                     visibility=visibility,
                     status=TrackStatus.VALIDATED if t.validated else TrackStatus.NEW,
+                    confidence=confidence,
                 )
             )
         out.sort(key=lambda o: o.track_id)

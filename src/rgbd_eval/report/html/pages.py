@@ -22,6 +22,7 @@ from rgbd_eval.config import Gating, RunConfig, config_to_dict, load_config
 from rgbd_eval.metrics import SequenceScores, Summary, summarize
 from rgbd_eval.pipeline import SequenceResult
 from rgbd_eval.report.html import plots
+from rgbd_eval.report.html.analysis_view import AnalysisView, analysis_view
 from rgbd_eval.report.html.events import busiest_frames, frame_errors, markers, worst_frames
 from rgbd_eval.report.html.overlay import drawn_tracks, rgb_frames
 from rgbd_eval.report.html.render import data_uri, jpeg_uri, render
@@ -33,6 +34,7 @@ if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
     from rgbd_eval.compare import Comparison
     from rgbd_eval.plugins import ReproduceResult
+    from rgbd_eval.report.analysis import Analysis
     from rgbd_eval.report.scoring import ScoredSequence
     from rgbd_eval.sweep import Point, SweepResult
 
@@ -155,8 +157,10 @@ def run_page(
     config: RunConfig,
     report: Mapping[str, Any],
     sections: Sequence[SequenceSection],
+    analysis: AnalysisView | None = None,
 ) -> str:
-    """``report.html`` of a run: header, metrics table, then one section per sequence."""
+    """``report.html`` of a run: where it fails, header, metrics table, the analysis
+    (:mod:`rgbd_eval.report.html.analysis_view`), then one section per sequence."""
     scored = any(r.scores is not None for r in results)
     return render(
         "run.html.j2",
@@ -172,6 +176,7 @@ def run_page(
         rows=table_rows(results, config.evaluation.gating) if scored else [],
         notes=run_notes(results),
         sections=sections,
+        analysis=analysis,
     )
 
 
@@ -182,9 +187,11 @@ def write_run_html(
     report: Mapping[str, Any],
     video: bool = False,
     progress: Progress | None = None,
+    analysis: Analysis | None = None,
 ) -> None:
     """Write ``report.html``, a ``<name>.birdseye.png`` per sequence and, with ``video``, a
-    ``<name>.overlay.mp4`` per sequence into ``folder`` (a run's staged output folder).
+    ``<name>.overlay.mp4`` per sequence into ``folder`` (a run's staged output folder);
+    with ``analysis``, the page shows it.
 
     The recordings are read again for the RGB images: with ``video`` every frame,
     else only up to the last frame of the strip (:func:`strip_frames`).
@@ -204,7 +211,8 @@ def write_run_html(
                 if rgb is not None
             }
         sections.append(_section(folder, SequenceView.of_run(r), images, shown, video_name))
-    write_text(folder / "report.html", run_page(results, config, report, sections))
+    view = None if analysis is None else analysis_view(analysis, report)
+    write_text(folder / "report.html", run_page(results, config, report, sections, view))
 
 
 def write_score_html(
@@ -212,6 +220,7 @@ def write_score_html(
     sequences: Sequence[ScoredSequence],
     report: Mapping[str, Any],
     gating: Gating,
+    analysis: Analysis | None = None,
 ) -> None:
     """Write ``report.html`` of ``rgbd-eval score`` into ``folder``: as a run's, without images.
 
@@ -239,6 +248,7 @@ def write_score_html(
         rows=score_rows(sequences, gating),
         notes=[f"{s.name}: warning: {w}" for s in sequences for w in s.warnings],
         sections=sections,
+        analysis=None if analysis is None else analysis_view(analysis, report),
     )
     write_text(folder / "report.html", page)
 
@@ -352,8 +362,8 @@ def compare_page(comparison: Comparison, baseline: str, current: str) -> str:
     rows = delta_rows(comparison)
     sequences = list(dict.fromkeys(r[0] for r in rows))
     metrics = list(dict.fromkeys(r[1] for r in rows))
-    # (sequence, metric, baseline, current, change, status) -> the change, coloured by status
-    cells = {(r[0], r[1]): (r[4], r[5]) for r in rows}
+    # (sequence, metric, baseline, current, change, interval, status) -> the change, by status
+    cells = {(r[0], r[1]): (r[4], r[-1]) for r in rows}
     return render(
         "compare.html.j2",
         title="rgbd-eval compare",
@@ -362,6 +372,7 @@ def compare_page(comparison: Comparison, baseline: str, current: str) -> str:
         header=HEADER,
         rows=rows,
         regressions=len(comparison.regressions),
+        gate=comparison.gate,
         config_changes=comparison.config_changes,
         notes=comparison.notes,
         chart=data_uri(plots.delta_grid(sequences, metrics, cells)),
