@@ -47,7 +47,6 @@ LAYERS = [
             "rgbd_eval.sim.motion",
             "rgbd_eval.sim.odometry",
             "rgbd_eval.sim.meshes",
-            "rgbd_eval.sim.figure",
             "rgbd_eval.sim.body",
             "rgbd_eval.sim.people",
         ],
