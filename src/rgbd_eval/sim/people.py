@@ -554,6 +554,11 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
         (HAIR, "hair"),
     ):
         thickness[wear == code] = THICKNESS[kind]
+    if look.hair_style == "long":
+        # the long-hair shell lies on the skin of the back: it goes over the top's cloth, or
+        # the back shows through it where the shoulders move in the walk
+        shell = np.unique(model.faces[model.face_group == names.index("helper-hair")])
+        thickness[shell] += THICKNESS[top.kind] + THICKNESS["hair"]
     rest = base + normals * thickness[:, None]
 
     # --- colours per vertex
@@ -634,7 +639,12 @@ def _dress(shape: BodyShape, look: Appearance) -> Dressed:
         colour2[sel] = worn.colour2
         scale[sel] = PATTERN_SCALE[worn.pattern]
     uv = model.face_uv[keep].astype(np.float64)
-    materials = np.where(t_wear == SKIN, MAT_SKIN, MAT_MATTE).astype(np.int32)
+    # the helper shells (long hair, the skirt) carry no garment code of their own: they are
+    # hair and cloth, not skin (the thermal camera and the depth model read skin apart)
+    t_worn = t_wear.copy()
+    t_worn[show_hair[keep]] = HAIR
+    t_worn[skirt[keep]] = TOP if top.kind == "dress" or bottom is None else BOTTOM
+    materials = np.where(t_worn == SKIN, MAT_SKIN, MAT_MATTE).astype(np.int32)
     surface = Surface(corner, uv, pattern, colour2, scale)
     surface = Surface(corner, uv, pattern, colour2, scale, surface.detailed())
     pelvis = label("pelvis")
