@@ -25,6 +25,7 @@ LAYERS = [
             "rgbd_eval.errors",
             "rgbd_eval.exact",
             "rgbd_eval.exact_kernels",
+            "rgbd_eval.verdicts",
             "rgbd_eval.machine",
             "rgbd_eval.files",
             "rgbd_eval.atomic",

@@ -49,8 +49,8 @@ def _frame_digest(scenario: str, index: int) -> str:
 
 #: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 3.
 PINNED = {
-    ("demo.yaml", 0): "ceef776d39d66cb7a08e71f10dc1578ad628ebf6750e68f5d49c18f5e98e4864",
-    ("demo.yaml", 100): "4a42bd1e25d5f53e571dd15f881f8441ea2cf37466513b1dff3cfc22b8db8cfa",
+    ("demo.yaml", 0): "49be74f2fc9978caac11f2ed58cf5eb856f39184b4fb9f1e18f7685a22a63716",
+    ("demo.yaml", 100): "a4956ecc2d22575f8f82373ba0cec8eee2f15318e675918ca1bc08062fc82a06",
     ("moving_complex.yaml", 40): "4e848f1605cabf2483330410f39d94e4fae5a0d83a5d4add97efb5818639bd20",
     (
         "satake2009_crossing.yaml",
@@ -59,7 +59,7 @@ PINNED = {
     (
         "cielniak2010/thermal_crossings.yaml",
         3,
-    ): "90ca680bc9e21fe4e02fece48a554755b41bb755b2f835a4df298be44c2ac14d",
+    ): "4f6b09c374847badd6a583a85536547a21a90e99cc506a9740fbcac7aa106715",
 }
 
 
@@ -78,7 +78,7 @@ def test_static_depth_cameras_are_the_pinned_bytes() -> None:
     h = hashlib.sha256()
     for image in rig.frame(3).images:
         h.update(image.depth.tobytes())
-    assert h.hexdigest() == "746588dc0de89ea41e145022468f1afe89b03ccebc244b4a9ea6a956c2ea4e26"
+    assert h.hexdigest() == "1235332589c3d3f3f409487bd1d69f10e472696b1bbc84efae35372dff34393a"
 
 
 # ----------------------------------------------------------------------------- the lint
