@@ -94,7 +94,10 @@ def _walker(**extra: Any) -> dict[str, Any]:
             "vfov_deg": 83.58, "depth_decimation": 4,
         },
         "people": [
-            {"id": 7, "path": [{"x": 2.6, "y": 0.0, "wait_s": 0.5}, {"x": 8.0, "y": 0.0, "speed": 0.5}]}
+            # short hair: long hair down the back of a dark top, seen from behind, is the
+            # colour test's known failure (methods/satake2009/colour.py), not this test's
+            {"id": 7, "hair_style": "short",
+             "path": [{"x": 2.6, "y": 0.0, "wait_s": 0.5}, {"x": 8.0, "y": 0.0, "speed": 0.5}]}
         ],
         "robot": {"camera_x": 0.1, "camera_height": 1.2},
         "rig": [{"kind": "stereo_pair", "name": "stereo", "width": 512, "height": 384}],

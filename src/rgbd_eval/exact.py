@@ -320,12 +320,22 @@ def hypot(x: X, y: X) -> X:
 # ----------------------------------------------------------------------------- linear algebra
 
 
+#: From this many rows on, :func:`matmul` runs its compiled kernel (same bits, less memory).
+_COMPILED_ROWS = 4096
+
+
 def matmul(a: F64, b: F64) -> F64:
     """``a @ b`` for a (..., K) stack of rows and a (K, M) matrix, summing k = 0, 1, ... in order."""
     A = np.asarray(a, dtype=np.float64)
     B = np.asarray(b, dtype=np.float64)
     if A.shape[-1] != B.shape[0] or B.ndim != 2:
         raise ValueError(f"cannot multiply {A.shape} by {B.shape}")
+    if A.ndim == 2 and A.shape[0] >= _COMPILED_ROWS:  # the same sums, compiled
+        from rgbd_eval.exact_kernels import matmul_rows
+
+        result = np.empty((A.shape[0], B.shape[1]))
+        matmul_rows(np.ascontiguousarray(A), np.ascontiguousarray(B), result)
+        return result
     out: F64 = A[..., 0:1] * B[0]
     for k in range(1, B.shape[0]):
         out = out + A[..., k : k + 1] * B[k]

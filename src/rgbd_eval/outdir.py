@@ -411,11 +411,14 @@ class OutputFolder:
             raise OutputError(target, f"cannot create its parent folder ({err.strerror})") from err
         remove_stale(parent, place.name)
         staging = parent / staging_name(place.name)
+        # known before it exists: a signal that arrives just after mkdir (its handler raises)
+        # still finds it to discard
+        self._staging = staging
         try:
             staging.mkdir(mode=0o777)  # the umask applies, unlike tempfile.mkdtemp's 0700
         except OSError as err:
+            self._staging = None
             raise OutputError(target, f"cannot write beside it ({err.strerror})") from err
-        self._staging = staging
         return staging
 
     def discard(self) -> None:

@@ -35,6 +35,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from rgbd_eval.errors import ConfigError
+from rgbd_eval.verdicts import Verdict
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -192,8 +193,13 @@ class ReproduceResult:
 
     markdown: str
     data: Mapping[str, Any]
-    #: (claim, held) pairs; how many held is part of the summary line.
-    claims: tuple[tuple[str, bool], ...] = ()
+    #: (claim, verdict) pairs: a :class:`~rgbd_eval.verdicts.Verdict`, or a bool (held or
+    #: failed on one run); how many held, failed and were inconclusive is the summary line.
+    claims: tuple[tuple[str, bool | Verdict], ...] = ()
+
+    def verdicts(self) -> list[tuple[str, Verdict]]:
+        """The claims with their verdicts (a bool read as one run's)."""
+        return [(t, v if isinstance(v, Verdict) else Verdict.of(v)) for t, v in self.claims]
 
 
 @dataclass

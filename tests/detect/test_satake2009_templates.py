@@ -2,30 +2,17 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from rgbd_eval.methods.satake2009 import templates as st
-from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
-from rgbd_eval.sim.render import make_scene, render_hits
-from rgbd_eval.types import OPTICAL_TO_BODY, CameraModel, Pose
 
-W, H = 512, 384
-CAM = CameraModel(W, H, st.F_REF, st.F_REF, (W - 1) / 2, (H - 1) / 2)
+from .satake_scenes import H, W, person_depth
 
 
 def _scene_depth(x: float, y: float, turned_deg: float, wall_m: float = 6.0) -> np.ndarray:
-    """Depth of a 1.75 m figure at (x, y) in front of a wall, camera 1.2 m up, level."""
-    body = np.eye(4)
-    body[2, 3] = 1.2
-    pose = Pose.from_matrix(body).compose(OPTICAL_TO_BODY)
-    outfit = Outfit((90, 90, 90), (50, 50, 50), (200, 160, 130), (40, 30, 20), (20, 20, 20))
-    heading = math.pi - math.radians(turned_deg)
-    mesh, _ = figure_mesh(1.75, x, y, heading, Posture(), outfit, 1)
-    z = render_hits(make_scene(mesh), CAM, pose).depth
-    return np.fmin(np.nan_to_num(z, nan=np.inf), wall_m).astype(np.float32)
+    """Depth of the test person (1.75 m) at (x, y) in front of a wall, camera 1.2 m up."""
+    return np.fmin(person_depth(x, y, turned_deg), wall_m).astype(np.float32)
 
 
 def test_shipped_templates_are_what_the_script_makes() -> None:

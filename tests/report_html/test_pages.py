@@ -257,3 +257,23 @@ def test_reproduce_claims_named_by_their_thesis_sentence_keep_source_and_evidenc
     )
     (row,) = _claims(result)
     assert (row.source, row.evidence) == ("7.3, Table 7.6", "FN 5% -> 9%")
+
+
+def test_reproduce_page_shows_an_inconclusive_verdict_apart() -> None:
+    # a claim that flips between seeds is shown as inconclusive, neither held nor failed
+    from rgbd_eval.plugins import ReproduceResult
+    from rgbd_eval.report.html.pages import reproduce_page
+    from rgbd_eval.verdicts import Verdict
+
+    result = ReproduceResult(
+        markdown="",
+        data={
+            "claims": [{"text": "B", "source": "s", "evidence": "seed 2: held | seed 3: failed"}]
+        },
+        claims=(("A", Verdict.HELD), ("B", Verdict.INCONCLUSIVE), ("C", False)),
+    )
+    html = reproduce_page(result, "satake2009", paper={})
+    assert html.count('class="left inconclusive">inconclusive<') == 1
+    assert html.count('class="left held">held<') == 1
+    assert html.count('class="left failed">did not hold<') == 1
+    assert "seed 2: held | seed 3: failed" in html

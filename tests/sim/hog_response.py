@@ -12,9 +12,11 @@ between 1.5 and 6 m, and on the boxes of person-sized non-person objects.
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rgbd_eval.detect.hog import hog_confidence
 from rgbd_eval.sim.annotate import clip_box, projected_extent
@@ -27,6 +29,7 @@ from rgbd_eval.sim.scenario import (
 )
 from rgbd_eval.sim.simulate import Simulator
 from rgbd_eval.sim.world import OBSTACLE_ID_BASE
+from rgbd_eval.types import Box2D
 
 PERSON_SIZED = (ObstacleKind.COAT_STAND, ObstacleKind.PLANT, ObstacleKind.CABINET)
 #: "Fully visible": at least this visible fraction and the whole box inside the image.
@@ -73,7 +76,14 @@ class Scores:
     by_kind: dict[str, list[float]] = field(default_factory=dict)
 
 
-def measure(scenario: Scenario, step: int, scores: Scores) -> None:
+def measure(
+    scenario: Scenario,
+    step: int,
+    scores: Scores,
+    scorer: Callable[[NDArray[np.uint8], Box2D], float] = hog_confidence,
+) -> None:
+    """Confidences of ``scorer`` (default: OpenCV's INRIA HOG) on fully visible people and on
+    person-sized objects, every ``step``-th frame."""
     sim = Simulator(scenario)
     cam = sim.rgb_camera
     objects = [
@@ -91,7 +101,7 @@ def measure(scenario: Scenario, step: int, scores: Scores) -> None:
             inside = b.left > 0 and b.top > 0 and b.right < cam.width and b.bottom < cam.height
             dist = float(np.hypot(*(np.asarray(gt.world_xyz[:2]) - cam_xyz[:2])))
             if inside and MIN_DIST <= dist <= MAX_DIST:
-                scores.people.append(hog_confidence(f.rgb, b))
+                scores.people.append(scorer(f.rgb, b))
         for oid, ob in objects:
             verts = sim.static.vertices[sim.static.triangles[sim.static.object_ids == oid].ravel()]
             extent = projected_extent(verts, cam, f.rgb_pose)
@@ -112,7 +122,7 @@ def measure(scenario: Scenario, step: int, scores: Scores) -> None:
             people = np.count_nonzero((window > 0) & (window < OBSTACLE_ID_BASE))
             if people > MAX_PERSON_SHARE * window.size:
                 continue  # someone stands in front of or behind the object
-            score = hog_confidence(f.rgb, box)
+            score = scorer(f.rgb, box)
             scores.objects.append(score)
             scores.by_kind.setdefault(ob.kind.value, []).append(score)
 

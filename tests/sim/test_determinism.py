@@ -47,19 +47,19 @@ def _frame_digest(scenario: str, index: int) -> str:
     return h.hexdigest()
 
 
-#: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 2.
+#: (scenario, frame) -> sha256 of what the simulator renders, on RENDERER_VERSION 3.
 PINNED = {
-    ("demo.yaml", 0): "10591af574ec0323bff385440ad5c946c2db5bc7c41030d9046d3fc15203c494",
-    ("demo.yaml", 100): "b0474c5f7894580e99d113ebb062c9689fbb026ffa96d8238f3a7ffe846e8db4",
-    ("moving_complex.yaml", 40): "45558d43e835976985942f8e184a3d5751b2389bdcadd7a33b4d6395d3f7954e",
+    ("demo.yaml", 0): "49be74f2fc9978caac11f2ed58cf5eb856f39184b4fb9f1e18f7685a22a63716",
+    ("demo.yaml", 100): "a4956ecc2d22575f8f82373ba0cec8eee2f15318e675918ca1bc08062fc82a06",
+    ("moving_complex.yaml", 40): "4e848f1605cabf2483330410f39d94e4fae5a0d83a5d4add97efb5818639bd20",
     (
         "satake2009_crossing.yaml",
         3,
-    ): "b15580ed5dbaa890cc0949d13ab0cc8599f102ced664ce504b0fb9fffed0c5ca",
+    ): "1e8f6f893c8bddfc5cd487875639bd603f086d70184a20d3bc0ff34bc1c07783",
     (
         "cielniak2010/thermal_crossings.yaml",
         3,
-    ): "b472c49cee02c3f4824308ed9dafe4026fefd85847d2c758e32716846b03ca35",
+    ): "4f6b09c374847badd6a583a85536547a21a90e99cc506a9740fbcac7aa106715",
 }
 
 
@@ -78,7 +78,7 @@ def test_static_depth_cameras_are_the_pinned_bytes() -> None:
     h = hashlib.sha256()
     for image in rig.frame(3).images:
         h.update(image.depth.tobytes())
-    assert h.hexdigest() == "9cf52a7710803b840ff45a1460379e902c32f1a875c957b9a462bd895183a62c"
+    assert h.hexdigest() == "1235332589c3d3f3f409487bd1d69f10e472696b1bbc84efae35372dff34393a"
 
 
 # ----------------------------------------------------------------------------- the lint

@@ -13,7 +13,6 @@ from rgbd_eval.sim.simulate import Simulator
 
 FY = 609.2755  # 240 / tan(21.5 deg)
 CY = 239.5
-S = 1.8 / 1.75  # width scale of a 1.8 m figure
 
 
 def scene(obstacles: list[dict[str, Any]] | None = None, **kw: Any) -> Scenario:
@@ -37,21 +36,34 @@ def scene(obstacles: list[dict[str, Any]] | None = None, **kw: Any) -> Scenario:
     return parse_scenario(data)
 
 
+def _person_mesh(sim: Simulator, index: int = 0) -> np.ndarray:
+    (_, mesh, _, _), *_ = sim.people_meshes(sim.time(index))
+    return mesh.vertices
+
+
 def test_person_at_a_known_position_projects_to_the_expected_box() -> None:
-    f = Simulator(scene()).frame(0)
+    sim = Simulator(scene())
+    f = sim.frame(0)
     (gt,) = f.ground_truth
-    assert gt.world_xyz == pytest.approx((4.1, 0.0, 0.9))  # centroid at half the height
+    v = _person_mesh(sim)
+    top = float(v[:, 2].max())
+    # the person stands at (4.1, 0); the centroid at half their current height (1.8 m tall,
+    # plus hair and standing straighter than the rest pose: within 2 cm)
+    assert gt.world_xyz == pytest.approx((4.1, 0.0, top / 2))
+    assert top == pytest.approx(1.8, abs=0.02)
     box = gt.box2d
     assert box is not None
-    # Top: the hair's crown at z = 1.8, 0.015 s behind the feet (facing away, towards the
-    # camera): depth 4.0 - 0.015 * 1.0286 = 3.98457; v = 239.5 - 609.2755 * 0.7 / 3.98457
-    # = 132.46, +0.5 for the pixel-edge convention -> 132.96
-    assert box.top == pytest.approx(CY - FY * 0.7 / (4.0 - 0.015 * S) + 0.5, abs=0.05)
-    # Bottom: the heels at z = 0, 0.075 s in front of the ankle: depth 4.0 - 0.07714 = 3.92286;
-    # v = 239.5 + 609.2755 * 1.1 / 3.92286 = 410.35 -> 410.85
-    assert box.bottom == pytest.approx(CY + FY * 1.1 / (4.0 - 0.075 * S) + 0.5, abs=0.05)
-    # left-right symmetric figure on the optical axis: centred on u = 319.5 + 0.5
-    assert box.left + box.width / 2 == pytest.approx(320.0, abs=0.05)
+    # The box spans the projected mesh. The camera sits at x = 0.1, 1.1 m high, level: a
+    # vertex at (x, y, z) projects to v = cy - fy (z - 1.1) / (x - 0.1); pixel-edge convention
+    # adds 0.5. Top: the highest projected vertex; bottom: the lowest.
+    depth = v[:, 0] - 0.1
+    rows = CY - FY * (v[:, 2] - 1.1) / depth + 0.5
+    assert box.top == pytest.approx(float(rows.min()), abs=1e-4)
+    assert box.bottom == pytest.approx(float(rows.max()), abs=1e-4)
+    # about 1.8 m tall at 4 m: (1.8 / 4) * 609.3 = 274 px, more for the nearer heels
+    assert 270.0 < box.height < 290.0
+    # the body is nearly left-right symmetric (it faces away, towards the camera's axis)
+    assert box.left + box.width / 2 == pytest.approx(320.0, abs=4.0)
     # the id buffer holds the person's pixels inside its box only
     vs, us = np.nonzero(f.ids == 1)
     assert us.min() >= box.left - 1 and us.max() <= box.right
@@ -83,13 +95,17 @@ def test_fully_occluded_and_out_of_view_people_are_ignored() -> None:
 
 def test_partly_out_of_the_image_box_is_clipped() -> None:
     # at 4 m the image spans y = +-4 * tan(28.5 deg) = +-2.17 m; a person at y = -2.17 is cut in half
-    f = Simulator(scene(people=[{"id": 2, "path": [{"x": 4.1, "y": -2.17}]}])).frame(0)
+    sim = Simulator(scene(people=[{"id": 2, "path": [{"x": 4.1, "y": -2.17}]}]))
+    f = sim.frame(0)
     (gt,) = f.ground_truth
     assert gt.box2d is not None
     assert gt.box2d.right == 640.0
-    # centre at u = 319.5 + 2.17 * 589.37 / 4 + 0.5 = 639.7; half the figure's width (arms,
-    # about 0.29 m * 1.0286) is 0.298 * 589.37 / 4 = 44 px -> left edge near 596
-    assert gt.box2d.left == pytest.approx(596.0, abs=6.0)
+    # the left edge is the leftmost projected vertex: u = cx - fx y / (x - 0.1) + 0.5
+    v = _person_mesh(sim)
+    fx = sim.rgb_camera.fx
+    cols = sim.rgb_camera.cx - fx * v[:, 1] / (v[:, 0] - 0.1) + 0.5
+    assert gt.box2d.left == pytest.approx(float(cols.min()), abs=1e-4)
+    assert 580.0 < gt.box2d.left < 620.0
     assert gt.visibility == pytest.approx(0.5, abs=0.1)
 
 

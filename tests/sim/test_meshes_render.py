@@ -89,7 +89,7 @@ def test_cached_static_render_equals_one_full_cast(index: int) -> None:
     sc = tiny_scenario(
         people=[
             {"id": 1, "path": [{"x": 3.0, "y": -1.0}, {"x": 3.0, "y": 1.0}]},
-            {"id": 2, "path": [{"x": 0.3, "y": 0.3}]},  # next to the camera, partly behind it
+            {"id": 2, "path": [{"x": 0.15, "y": 0.3}]},  # beside the camera, partly behind it
         ]
     )
     sim = Simulator(sc, 0)
@@ -100,7 +100,11 @@ def test_cached_static_render_equals_one_full_cast(index: int) -> None:
     full = render_hits(make_scene(mesh), sim.rgb_camera, f.rgb_pose)
     ids = np.where(full.triangle >= 0, mesh.object_ids[np.maximum(full.triangle, 0)], -1)
     assert np.array_equal(ids, f.ids)
-    assert np.any(f.ids == 1) and np.any(f.ids == 2)
+    assert np.any(f.ids == 1)
+    # person 2 straddles the camera's plane: the near-plane clipping is exercised
+    near = sim.people_meshes(t)[1][1].vertices
+    depth = f.rgb_pose.inverse().transform_points(near)[:, 2]
+    assert depth.min() < 0.0 < depth.max()
 
 
 @pytest.mark.parametrize("kind", [k for k in ObstacleKind if k is not ObstacleKind.PICTURE])

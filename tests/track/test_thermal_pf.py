@@ -59,9 +59,12 @@ def _scene(x: float, y: float) -> dict[str, object]:
     }
 
 
-def _render(x: float, y: float) -> tuple[np.ndarray, tuple[float, float, float]]:
-    """A noisy thermal image of one person, and the person's true (u, v, h) from the id mask."""
-    sim = Simulator(parse_scenario(_scene(x, y)), seed=3)
+def _render(x: float, y: float, seed: int) -> tuple[np.ndarray, tuple[float, float, float]]:
+    """A noisy thermal image of one person, and the person's true (u, v, h) from the id mask.
+
+    The scenario seed draws the person (body, clothes, hair: :mod:`rgbd_eval.sim.people`).
+    """
+    sim = Simulator(parse_scenario(_scene(x, y)), seed=seed)
     sim.frame(0)
     cam = ThermalCamera(ThermalCameraConfig(name="thermal"), "odom")
     view = sim.scene_view(0, 0)
@@ -73,20 +76,33 @@ def _render(x: float, y: float) -> tuple[np.ndarray, tuple[float, float, float]]
     return temp, ((u0 + u1) / 2.0, (v0 + v1) / 2.0, float(v1 - v0))
 
 
-@pytest.mark.parametrize(("x", "y"), [(3.5, 0.0), (5.0, 0.8), (4.0, -1.0)])
-def test_silhouette_score_peaks_at_the_true_pose_of_a_rendered_person(x: float, y: float) -> None:
-    temp, (u, v, h) = _render(x, y)
+_POSITIONS = [(3.5, 0.0), (5.0, 0.8), (4.0, -1.0)]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_silhouette_score_peaks_at_the_true_pose_of_a_rendered_person(seed: int) -> None:
+    # six people (scenario seeds 0-5: bodies from 1.50 to 1.95 m, skirts, dresses, long
+    # hair, jackets), each at one of three places 3.5-5 m away, seen whole: the id mask's
+    # box is the true pose
+    x, y = _POSITIONS[seed % 3]
+    temp, (u, v, h) = _render(x, y, seed)
     # a grid of +-30% of h in position and +-30% in size, in steps of 2% of h
     steps = np.arange(-0.30, 0.301, 0.02)
     du, dv, ds = np.meshgrid(steps, steps, steps, indexing="ij")
     states = np.stack([u + du.ravel() * h, v + dv.ravel() * h, h * (1 + ds.ravel())], axis=1)
     scores = silhouette_scores(temp.astype(np.float32), SIL, states)
     best = states[int(np.argmax(scores))]
-    # (people 3.5-5 m away are seen whole: the id mask's box is the true pose)
-    # the best state lies within 5% of h of the true centre and 8% of its size
+    # the silhouette is a fixed head/torso/legs shape and people are not. Measured on these
+    # six (renderer version 3): centred within 4% of h across, sizes 1.00-1.12 of h, span
+    # IoU 0.89-0.96 (a single head-to-feet ellipse: sizes 0.78-1.02, IoU 0.78-1.00). The best
+    # state is centred within 5% of h across and its top-to-feet span overlaps the true one
+    # by IoU >= 0.75; a silhouette locked on half the person (what a one-pixel gradient
+    # picked, see rgbd_eval.track.silhouette) has IoU 0.5.
     assert abs(best[0] - u) <= 0.05 * h
-    assert abs(best[1] - v) <= 0.05 * h
-    assert abs(best[2] - h) <= 0.08 * h
+    top, feet = best[1] - best[2] / 2, best[1] + best[2] / 2
+    inter = min(feet, v + h / 2) - max(top, v - h / 2)
+    union = max(feet, v + h / 2) - min(top, v - h / 2)
+    assert inter / union >= 0.75, (best - [u, v, h]) / h
     # and it scores well above a displaced silhouette (a quarter height to the side)
     off = silhouette_scores(temp.astype(np.float32), SIL, np.array([[u + 0.25 * h, v, h]]))[0]
     assert scores.max() > 2.0 * off

@@ -18,6 +18,7 @@ from rgbd_eval.cli.common import (
 )
 from rgbd_eval.errors import OutputError
 from rgbd_eval.outdir import OutputFolder
+from rgbd_eval.verdicts import tally
 
 
 @handle_errors
@@ -80,9 +81,8 @@ def reproduce(
         write_text(staging / "reproduce.html", reproduce_page(result, system))
         folder.commit()
     console.print(result.markdown, markup=False)
-    held = sum(ok for _, ok in result.claims)
     if result.claims:
-        console.print(f"claims held: {held} of {len(result.claims)}")
+        console.print("claims: " + tally([v for _, v in result.verdicts()]))
     console.print(
         f"written: {out_dir / 'reproduce.md'}, {out_dir / 'reproduce.json'}, "
         f"{out_dir / 'reproduce.html'}"

@@ -4,7 +4,7 @@ A one-way stack, each module importing only those of the layers before it:
 
 1. scenario model: ``scenario`` (rooms, people, robot, sensor), ``rig_config`` (the rig's
    extra sensors as config);
-2. motion and bodies: ``motion``, ``odometry``, ``meshes``, ``figure``, ``body``;
+2. motion and bodies: ``motion``, ``odometry``, ``meshes``, ``body``;
 3. world: ``world`` (static scene and people meshes), ``raster``, ``render`` (ray casting);
 4. sensors: ``rig`` (camera models, tf, the view a sensor renders from), ``sensor`` (noise
    models), ``annotate`` (ground truth from the id buffer), ``stereo_rig``,

@@ -436,6 +436,12 @@ class RestBody:
         skin_r, skin_t = self.skinning(pose)
         return _skin(self.vertices, self.model.skin_bone, self.model.skin_weight, skin_r, skin_t)
 
+    def skinned(self, vertices: F64, pose: Pose) -> F64:
+        """Other rest positions of this body's mesh vertices (V, 3), e.g. pushed out by the
+        thickness of clothes, in ``pose`` with this body's skinning weights."""
+        skin_r, skin_t = self.skinning(pose)
+        return _skin(vertices, self.model.skin_bone, self.model.skin_weight, skin_r, skin_t)
+
     def walk_vertices(
         self,
         phase: float,
@@ -819,7 +825,7 @@ _WALK_FK = (
 
 
 #: Phases per cycle of the foot-lock table and of the posed-vertex cache; strides cached.
-LOCK_SAMPLES = 96
+LOCK_SAMPLES = 32
 VERTEX_PHASES = 32
 WALK_TABLES = 4
 #: A sole vertex touches the floor when it is this low (metres).

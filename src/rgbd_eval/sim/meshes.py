@@ -25,6 +25,57 @@ MAT_MATTE = 0
 MAT_SHINY = 1
 MAT_SKIN = 2
 MAT_FLOOR = 3  # matte with a tile pattern
+MAT_WALL = 4  # matte, painted plaster: a faint mottle
+
+
+#: Surface patterns (per triangle), drawn per pixel from the triangle's texture coordinates.
+PATTERN_NONE = 0
+PATTERN_STRIPES = 1  # bands across v: a striped shirt
+PATTERN_CHECK = 2  # two crossing sets of bands: a checked shirt
+PATTERN_DOTS = 3  # a print: round dots on a jittered grid
+PATTERN_WEAVE = 4  # fine noise of the second colour: denim, knitwear
+
+
+@dataclass(frozen=True)
+class Surface:
+    """What a mesh's triangles look like beyond their flat colour (all arrays per triangle).
+
+    ``corner_colours`` (T, 3, 3) are the albedos at the corners, blended across each triangle
+    (skin tones, lips, eyebrows); ``uv`` (T, 3, 2) texture coordinates at the corners;
+    ``pattern`` (T,) one of the ``PATTERN_*`` codes drawn with ``colour2`` (T, 3) at
+    ``scale`` (T,) repeats per texture unit.
+    """
+
+    corner_colours: F64
+    uv: F64
+    pattern: I32
+    colour2: F64
+    scale: F64
+    #: :meth:`detailed`, when known (None: found from the arrays).
+    detail: NDArray[np.bool_] | None = None
+
+    def detailed(self) -> NDArray[np.bool_]:
+        """Triangles with more than one flat colour: a pattern or corners that differ."""
+        if self.detail is not None:
+            return self.detail
+        cc = self.corner_colours
+        varies = (cc != cc[:, :1]).any(axis=(1, 2))
+        out: NDArray[np.bool_] = varies | (self.pattern != PATTERN_NONE)
+        return out
+
+    @staticmethod
+    def plain(colours: F64) -> Surface:
+        """Flat colours (T, 3), no texture."""
+        c = np.asarray(colours, dtype=np.float64)
+        n = len(c)
+        return Surface(
+            np.repeat(c[:, None, :], 3, axis=1),
+            np.zeros((n, 3, 2)),
+            np.zeros(n, dtype=np.int32),
+            c.copy(),
+            np.ones(n),
+            np.zeros(n, dtype=bool),
+        )
 
 
 @dataclass(frozen=True)
@@ -37,10 +88,27 @@ class Mesh:
     colours: F64  # (T, 3) albedo in [0, 255]
     object_ids: I32  # (T,)
     materials: I32  # (T,)
+    #: Texture and colour detail; None: each triangle's flat colour.
+    surface: Surface | None = None
+    #: Per triangle: its vertex normals differ (a smooth surface: normals are blended).
+    #: None: found from the normals when needed (:meth:`smooth_triangles`).
+    smooth: NDArray[np.bool_] | None = None
 
     @property
     def n_triangles(self) -> int:
         return int(self.triangles.shape[0])
+
+    def smooth_triangles(self) -> NDArray[np.bool_]:
+        """Triangles whose vertex normals differ (the shading blends their normals)."""
+        if self.smooth is not None:
+            return self.smooth
+        n = self.normals[self.triangles]  # (T, 3, 3)
+        out: NDArray[np.bool_] = np.abs(n - n[:, :1]).max(axis=(1, 2)) > 1e-4
+        return out
+
+    def surface_or_plain(self) -> Surface:
+        """The surface, or one of flat colours."""
+        return self.surface if self.surface is not None else Surface.plain(self.colours)
 
 
 @lru_cache(maxsize=8)
@@ -295,6 +363,20 @@ def concatenate(meshes: list[Mesh]) -> Mesh:
     if not meshes:
         return empty_mesh()
     offsets = np.cumsum([0] + [len(m.vertices) for m in meshes[:-1]])
+    surface = None
+    if any(m.surface is not None for m in meshes):
+        parts = [m.surface_or_plain() for m in meshes]
+        surface = Surface(
+            np.concatenate([p.corner_colours for p in parts]),
+            np.concatenate([p.uv for p in parts]),
+            np.concatenate([p.pattern for p in parts]),
+            np.concatenate([p.colour2 for p in parts]),
+            np.concatenate([p.scale for p in parts]),
+            np.concatenate([p.detailed() for p in parts]),
+        )
+    smooth = None
+    if any(m.smooth is not None for m in meshes):
+        smooth = np.concatenate([m.smooth_triangles() for m in meshes])
     return Mesh(
         np.concatenate([m.vertices for m in meshes]),
         np.concatenate([m.normals for m in meshes]),
@@ -304,4 +386,6 @@ def concatenate(meshes: list[Mesh]) -> Mesh:
         np.concatenate([m.colours for m in meshes]),
         np.concatenate([m.object_ids for m in meshes]),
         np.concatenate([m.materials for m in meshes]),
+        surface,
+        smooth,
     )

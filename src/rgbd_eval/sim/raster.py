@@ -34,36 +34,66 @@ NEAR = 1e-3
 
 
 @numba.njit(cache=True)
-def _clip_bbox(
-    a: F64, b: F64, c: F64, fx: float, fy: float, cx: float, cy: float, near: float
-) -> tuple[float, float, float, float, bool]:
-    """Grid-coordinate bounds of a triangle's part in front of ``z = near``; False if none."""
-    u0 = np.inf
-    v0 = np.inf
-    u1 = -np.inf
-    v1 = -np.inf
-    found = False
+def _polygon(
+    a: F64,
+    b: F64,
+    c: F64,
+    projected: F64,
+    corners: tuple[int, int, int],
+    grid: F64,
+    out: F64,
+) -> int:
+    """The grid coordinates of a triangle's part in front of ``z = near``, a convex polygon
+    of up to four corners, into ``out`` (4, 2); returns the number of corners (0: none).
+
+    Corners ahead are taken from ``projected``; where an edge crosses the plane, the
+    crossing point is projected.
+    """
+    fx, fy, cx, cy, near = grid[0], grid[1], grid[2], grid[3], grid[4]
+    n = 0
     for i in range(3):
         p = a if i == 0 else b if i == 1 else c
         q = b if i == 0 else c if i == 1 else a
         if p[2] >= near:
-            u = fx * (p[0] / p[2]) + cx
-            v = fy * (p[1] / p[2]) + cy
-            u0, v0, u1, v1 = min(u0, u), min(v0, v), max(u1, u), max(v1, v)
-            found = True
+            out[n, 0] = projected[corners[i], 0]
+            out[n, 1] = projected[corners[i], 1]
+            n += 1
         if (p[2] >= near) != (q[2] >= near):  # the edge crosses the plane: its crossing point
             s = (near - p[2]) / (q[2] - p[2])
             x = p[0] + s * (q[0] - p[0])
             y = p[1] + s * (q[1] - p[1])
-            u = fx * (x / near) + cx
-            v = fy * (y / near) + cy
-            u0, v0, u1, v1 = min(u0, u), min(v0, v), max(u1, u), max(v1, v)
-            found = True
-    return u0, v0, u1, v1, found
+            out[n, 0] = fx * (x / near) + cx
+            out[n, 1] = fy * (y / near) + cy
+            n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def _row_span(poly: F64, n: int, lo: float, hi: float) -> tuple[float, float, bool]:
+    """The u extent of the convex polygon ``poly[:n]`` within the band ``lo <= v <= hi``;
+    False if it does not reach into the band.
+
+    The band's part of a convex polygon is convex; its corners are the polygon's corners
+    inside the band and the edges' crossings of the band's two lines.
+    """
+    u0 = np.inf
+    u1 = -np.inf
+    for e in range(n):
+        pu, pv = poly[e, 0], poly[e, 1]
+        qu, qv = poly[(e + 1) % n, 0], poly[(e + 1) % n, 1]
+        if lo <= pv <= hi:
+            u0, u1 = min(u0, pu), max(u1, pu)
+        for line in (lo, hi):
+            if (pv < line < qv) or (qv < line < pv):
+                s = min(max((line - pv) / (qv - pv), 0.0), 1.0)
+                u = pu + s * (qu - pu)
+                u0, u1 = min(u0, u), max(u1, u)
+    return u0, u1, u0 <= u1
 
 
 def _cast_into(
     vertices: F64,
+    projected: F64,
     triangles: I32,
     triangle_offset: int,
     directions: F64,
@@ -79,28 +109,52 @@ def _cast_into(
 ) -> None:
     """Update the nearest hits of the rays with the triangles (all in the rays' frame).
 
+    ``projected`` (V, 2) holds each vertex's grid coordinates (for vertices at ``z >= near``).
     ``grid`` is (fx, fy, cx, cy, near) and ``grid_size`` (width, height) of the cell grid;
     the rays of cell ``k = row * width + col`` are ``cell_rays[cell_start[k]:cell_start[k+1]]``.
     A hit counts when ``near_t < t < t_max[ray]`` (``near_t`` = ``grid[4]`` times the ray's z).
     """
-    fx, fy, cx, cy, near = grid[0], grid[1], grid[2], grid[3], grid[4]
+    near = grid[4]
     gw, gh = grid_size[0], grid_size[1]
+    poly = np.empty((4, 2))
     for k in range(triangles.shape[0]):
-        a = vertices[triangles[k, 0]]
-        b = vertices[triangles[k, 1]]
-        c = vertices[triangles[k, 2]]
-        if a[2] < near and b[2] < near and c[2] < near:
+        ia, ib, ic = triangles[k, 0], triangles[k, 1], triangles[k, 2]
+        a = vertices[ia]
+        b = vertices[ib]
+        c = vertices[ic]
+        in_a, in_b, in_c = a[2] >= near, b[2] >= near, c[2] >= near
+        if not (in_a or in_b or in_c):
             continue
-        bu0, bv0, bu1, bv1, found = _clip_bbox(a, b, c, fx, fy, cx, cy, near)
-        if not found:
+        whole = in_a and in_b and in_c
+        if whole:  # wholly ahead: the corners' projections bound it
+            n = 3
+            bu0 = min(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bu1 = max(projected[ia, 0], projected[ib, 0], projected[ic, 0])
+            bv0 = min(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+            bv1 = max(projected[ia, 1], projected[ib, 1], projected[ic, 1])
+        else:
+            n = _polygon(a, b, c, projected, (ia, ib, ic), grid, poly)
+            bu0 = min(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
+            bu1 = max(poly[0, 0], poly[1, 0], poly[2, 0], poly[n - 1, 0])
+            bv0 = min(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
+            bv1 = max(poly[0, 1], poly[1, 1], poly[2, 1], poly[n - 1, 1])
+        # the cells [i - 1/2, i + 1/2) the box touches (a pixel's ray lies at its cell's
+        # centre); 1e-6 of a cell more on each side for the rounding of the projections
+        if bu1 < -1.0 or bv1 < -1.0 or bu0 > gw or bv0 > gh:
             continue
-        # cells whose centre may lie in the box, one cell of margin for rounding
-        i0 = max(int(np.floor(bu0)) - 1, 0)
-        j0 = max(int(np.floor(bv0)) - 1, 0)
-        i1 = min(int(np.ceil(bu1)) + 1, gw - 1)
-        j1 = min(int(np.ceil(bv1)) + 1, gh - 1)
+        i0 = max(int(np.floor(bu0 + 0.5 - 1e-6)), 0)
+        j0 = max(int(np.floor(bv0 + 0.5 - 1e-6)), 0)
+        i1 = min(int(np.floor(bu1 + 0.5 + 1e-6)), gw - 1)
+        j1 = min(int(np.floor(bv1 + 0.5 + 1e-6)), gh - 1)
         if i0 > i1 or j0 > j1:
             continue
+        # a large box: test only the cells each row of the triangle reaches (not worth it
+        # for the few cells of a small one)
+        wide = (i1 - i0 + 1) * (j1 - j0 + 1) > 32 and j1 > j0
+        if wide and whole:
+            for m, corner in enumerate((ia, ib, ic)):
+                poly[m, 0] = projected[corner, 0]
+                poly[m, 1] = projected[corner, 1]
         e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
         e2x, e2y, e2z = c[0] - a[0], c[1] - a[1], c[2] - a[2]
         # the ray origin is the frame's origin: tvec = -a
@@ -111,7 +165,14 @@ def _cast_into(
         t_num = e2x * qx + e2y * qy + e2z * qz
         for j in range(j0, j1 + 1):
             row = j * gw
-            for i in range(i0, i1 + 1):
+            r0, r1 = i0, i1
+            if wide:  # only the cells of this row the triangle reaches
+                su0, su1, inside = _row_span(poly, n, j - 0.5 - 1e-6, j + 0.5 + 1e-6)
+                if not inside:
+                    continue
+                r0 = max(int(np.floor(su0 + 0.5 - 1e-6)), i0)
+                r1 = min(int(np.floor(su1 + 0.5 + 1e-6)), i1)
+            for i in range(r0, r1 + 1):
                 cell = row + i
                 for r in range(cell_start[cell], cell_start[cell + 1]):
                     ray = cell_rays[r]
@@ -189,8 +250,15 @@ class RayBundle:
         """Keep the nearer hits of these triangles (vertices in the rays' frame)."""
         if triangles.shape[0] == 0:
             return
+        v = np.ascontiguousarray(vertices, dtype=np.float64)
+        fx, fy, cx, cy, near = self._grid
+        z = np.where(v[:, 2] >= near, v[:, 2], 1.0)  # the others are never read
+        projected = np.empty((len(v), 2))
+        projected[:, 0] = fx * (v[:, 0] / z) + cx
+        projected[:, 1] = fy * (v[:, 1] / z) + cy
         _cast_kernel(
-            np.ascontiguousarray(vertices, dtype=np.float64),
+            v,
+            projected,
             np.ascontiguousarray(triangles, dtype=np.int32),
             int(triangle_offset),
             self.directions,

@@ -10,14 +10,26 @@ bytes on every CPU. Shading is Lambertian with a hemispheric ambient term, smoot
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval import exact
-from rgbd_eval.sim.meshes import MAT_FLOOR, Mesh
+from rgbd_eval.sim.meshes import (
+    MAT_FLOOR,
+    MAT_WALL,
+    PATTERN_CHECK,
+    PATTERN_DOTS,
+    PATTERN_NONE,
+    PATTERN_STRIPES,
+    PATTERN_WEAVE,
+    Mesh,
+    Surface,
+)
 from rgbd_eval.sim.raster import RayBundle, binned_rays, pixel_rays
 from rgbd_eval.sim.world import NO_HIT
 from rgbd_eval.types import CameraModel, Pose
@@ -89,6 +101,37 @@ def _camera_rays(
     return d, cells
 
 
+def _gather(
+    triangle: I32,
+    t: F64,
+    u: F64,
+    v: F64,
+    face_normals: F32,
+    depth: F32,
+    uv: F32,
+    normals: F32,
+) -> None:
+    """Per ray: depth (NaN: no hit), barycentrics and the hit triangle's normal (0: none),
+    as float32 (each value rounded once, as numpy's casts do)."""
+    for i in range(triangle.shape[0]):
+        k = triangle[i]
+        uv[i, 0] = u[i]
+        uv[i, 1] = v[i]
+        if k >= 0:
+            depth[i] = t[i]
+            normals[i, 0] = face_normals[k, 0]
+            normals[i, 1] = face_normals[k, 1]
+            normals[i, 2] = face_normals[k, 2]
+        else:
+            depth[i] = np.nan
+            normals[i, 0] = 0.0
+            normals[i, 1] = 0.0
+            normals[i, 2] = 0.0
+
+
+_gather_kernel: Callable[..., None] = numba.njit(cache=True)(_gather)
+
+
 class CameraCast:
     """One camera's pixel rays from a pose, with the nearest hits cast so far."""
 
@@ -119,11 +162,13 @@ class CameraCast:
         """The hits so far; ``face_normals`` (T, 3) of every triangle id that was cast."""
         b = self._bundle
         h, w = self.camera.height, self.camera.width
-        hit = b.triangle >= 0
-        depth = np.where(hit, b.t, np.nan).astype(np.float32)
-        uv = np.stack([b.u, b.v], axis=1).astype(np.float32)
-        normals = np.zeros((len(hit), 3), dtype=np.float32)
-        normals[hit] = face_normals[b.triangle[hit]]
+        n = len(b.triangle)
+        depth = np.empty(n, dtype=np.float32)
+        uv = np.empty((n, 2), dtype=np.float32)
+        normals = np.empty((n, 3), dtype=np.float32)
+        _gather_kernel(
+            b.triangle, b.t, b.u, b.v, np.ascontiguousarray(face_normals), depth, uv, normals
+        )
         return Hits(
             depth.reshape(h, w),
             b.triangle.reshape(h, w),
@@ -204,40 +249,203 @@ def floor_pattern(points: NDArray[np.float32], tile: float) -> NDArray[np.float3
     return k.astype(np.float32)
 
 
-def shade(mesh: Mesh, hits: Hits, light: F64, floor_tile: float) -> NDArray[np.float32]:
-    """Lit colour image ((H, W, 3) float32, 0..255): Lambert plus hemispheric ambient."""
+def _hash01(i: NDArray[np.int64], j: NDArray[np.int64]) -> F64:
+    """A fixed pseudo-random value in [0, 1) per integer cell (integer arithmetic only)."""
+    h = (i * 73856093) ^ (j * 19349663) ^ 0x5BD1E995
+    h = (h ^ (h >> 13)) * 1274126177
+    out: F64 = ((h ^ (h >> 16)) & 0xFFFF).astype(np.float64) / 65536.0
+    return out
+
+
+def pattern_mask(kind: NDArray[np.int32], uv: F64, scale: F64) -> F64:
+    """How much of the second colour shows (0..1) at texture coordinates ``uv`` (N, 2)."""
+    su, sv = uv[:, 0] * scale, uv[:, 1] * scale
+    fu, fv = su - np.floor(su), sv - np.floor(sv)
+    iu, iv = np.floor(su).astype(np.int64), np.floor(sv).astype(np.int64)
+    stripes = (fv < 0.45).astype(np.float64)
+    check = 0.5 * (fu < 0.3) + 0.5 * (fv < 0.3)
+    du = fu - (0.3 + 0.4 * _hash01(iu, iv))
+    dv = fv - (0.3 + 0.4 * _hash01(iv + 7, iu + 3))
+    dots = ((du * du + dv * dv) < 0.04).astype(np.float64)
+    weave = 0.22 * _hash01(iu, iv)
+    out: F64 = np.select(
+        [
+            kind == PATTERN_STRIPES,
+            kind == PATTERN_CHECK,
+            kind == PATTERN_DOTS,
+            kind == PATTERN_WEAVE,
+        ],
+        [stripes, check, dots, weave],
+        0.0,
+    )
+    return out
+
+
+def surface_colours(surface: Surface, tri: I32, bary: NDArray[np.float32], flat: F64) -> F64:
+    """Albedo (N, 3) at hits on triangles ``tri`` with barycentrics ``bary`` (N, 2); ``flat``
+    (N, 3) is the triangles' flat colour, kept where the surface has no detail."""
+    colour: F64 = np.array(flat, dtype=np.float64)
+    kind = surface.pattern[tri]
+    sel = np.flatnonzero(surface.detailed()[tri])
+    if sel.size == 0:
+        return colour
+    t = tri[sel]
+    u = bary[sel, 0:1].astype(np.float64)
+    v = bary[sel, 1:2].astype(np.float64)
+    w = 1.0 - u - v
+    cc = surface.corner_colours[t]
+    colour[sel] = cc[:, 0] * w + cc[:, 1] * u + cc[:, 2] * v
+    patterned = np.flatnonzero(kind[sel] != PATTERN_NONE)
+    if patterned.size:
+        at = sel[patterned]
+        tp = t[patterned]
+        tuv = surface.uv[tp]
+        wp, up, vp = w[patterned], u[patterned], v[patterned]
+        uv = tuv[:, 0] * wp + tuv[:, 1] * up + tuv[:, 2] * vp
+        m = pattern_mask(kind[at], uv, surface.scale[tp])[:, None]
+        colour[at] = colour[at] * (1.0 - m) + surface.colour2[tp] * m
+    return colour
+
+
+def wall_pattern(points: NDArray[np.float32]) -> F64:
+    """Brightness factor of painted plaster at world points (N, 3): a faint mottle (+-3 %)
+    over 3 cm cells, and a coarser one (+-2 %) over 25 cm."""
+    p = points.astype(np.float64)
+    along = p[:, 0] + p[:, 1]  # walls run along x or y
+    fine = _hash01(
+        np.floor(along / 0.03).astype(np.int64), np.floor(p[:, 2] / 0.03).astype(np.int64)
+    )
+    coarse = _hash01(
+        np.floor(along / 0.25).astype(np.int64) + 11, np.floor(p[:, 2] / 0.25).astype(np.int64)
+    )
+    out: F64 = 1.0 + 0.06 * (fine - 0.5) + 0.04 * (coarse - 0.5)
+    return out
+
+
+def contact_shadow(
+    points: NDArray[np.float32], casters: Sequence[tuple[float, float, float]]
+) -> F64:
+    """Brightness factor (N,) of floor points under soft shadows of ``casters`` (x, y, radius):
+    darkest (0.55) under each, fading over its radius (ambient light blocked by a body)."""
+    k = np.ones(len(points))
+    p = points.astype(np.float64)
+    for x, y, r in casters:
+        dx, dy = p[:, 0] - x, p[:, 1] - y
+        k = k * (1.0 - 0.45 * exact.exp(-(dx * dx + dy * dy) / (2.0 * r * r)))
+    return k
+
+
+def _lookup(flags: NDArray[np.bool_], tri: I32) -> NDArray[np.bool_]:
+    """Per pixel: ``flags`` of its triangle (False where nothing was hit)."""
+    out: NDArray[np.bool_] = np.concatenate([flags, [False]])[tri]  # tri -1 reads the False
+    return out
+
+
+def _albedo(tri: I32, colours: NDArray[np.float32], out: NDArray[np.float32]) -> None:
+    """Per pixel: its triangle's flat colour (anything where nothing was hit)."""
+    for p in range(tri.shape[0]):
+        t = max(tri[p], 0)
+        for k in range(3):
+            out[p, k] = colours[t, k]
+
+
+_albedo_kernel: Callable[..., None] = numba.njit(cache=True)(_albedo)
+
+
+def _light(
+    tri: I32,
+    bary: NDArray[np.float32],
+    face_normals: NDArray[np.float32],
+    directions: NDArray[np.float32],
+    triangles: I32,
+    normals: NDArray[np.float32],
+    smooth: NDArray[np.bool_],
+    albedo: NDArray[np.float32],
+    light: NDArray[np.float32],
+    out: NDArray[np.float32],
+) -> None:
+    """Per pixel: the normal (blended from the vertex normals on smooth triangles, the face
+    normal on flat ones, turned towards the camera), Lambert plus hemispheric ambient light
+    on the albedo; the background where nothing was hit. float32, a fixed order."""
+    one = np.float32(1.0)
+    for p in range(tri.shape[0]):
+        t = tri[p]
+        if t < 0:
+            for k in range(3):
+                out[p, k] = np.float32(BACKGROUND)
+            continue
+        if smooth[t]:
+            u, v = bary[p, 0], bary[p, 1]
+            w = one - u - v
+            a, b, c = triangles[t, 0], triangles[t, 1], triangles[t, 2]
+            nx = normals[a, 0] * w + normals[b, 0] * u + normals[c, 0] * v
+            ny = normals[a, 1] * w + normals[b, 1] * u + normals[c, 1] * v
+            nz = normals[a, 2] * w + normals[b, 2] * u + normals[c, 2] * v
+        else:
+            nx, ny, nz = face_normals[p, 0], face_normals[p, 1], face_normals[p, 2]
+        facing = nx * directions[p, 0] + ny * directions[p, 1] + nz * directions[p, 2]
+        length = np.sqrt(nx * nx + ny * ny + nz * nz)
+        scale = (-one if facing > 0 else one) / max(length, np.float32(1e-6))
+        nx, ny, nz = nx * scale, ny * scale, nz * scale
+        lambert = max(nx * light[0] + ny * light[1] + nz * light[2], np.float32(0.0))
+        intensity = np.float32(0.38) + np.float32(0.12) * nz + np.float32(0.62) * lambert
+        for k in range(3):
+            out[p, k] = albedo[p, k] * intensity
+
+
+_light_kernel: Callable[..., None] = numba.njit(cache=True)(_light)
+
+
+def shade(
+    mesh: Mesh,
+    hits: Hits,
+    light: F64,
+    floor_tile: float,
+    casters: Sequence[tuple[float, float, float]] = (),
+) -> NDArray[np.float32]:
+    """Lit colour image ((H, W, 3) float32, 0..255): Lambert plus hemispheric ambient.
+
+    Textured surfaces (:class:`~rgbd_eval.sim.meshes.Surface`) are drawn per pixel; the
+    floor gets its tiles and the soft contact shadows of ``casters`` (x, y, radius).
+    """
     H, W = hits.triangle.shape
     tri = hits.triangle.reshape(-1)
-    hit = tri >= 0
-    safe = np.maximum(tri, 0)
-    colour = mesh.colours.astype(np.float32)[safe]
-    floor = np.flatnonzero(hit & (mesh.materials[safe] == MAT_FLOOR))
+    colour = np.empty((len(tri), 3), dtype=np.float32)
+    _albedo_kernel(tri, mesh.colours.astype(np.float32), colour)
+    bary = hits.uv.reshape(-1, 2)
+    if mesh.surface is not None:
+        detailed = np.flatnonzero(_lookup(mesh.surface.detailed(), tri))
+        if detailed.size:
+            t = tri[detailed]
+            colour[detailed] = surface_colours(
+                mesh.surface, t, bary[detailed], colour[detailed].astype(np.float64)
+            )
+    wall = np.flatnonzero(_lookup(mesh.materials == MAT_WALL, tri))
+    if wall.size:
+        d_wall = hits.directions.reshape(-1, 3)[wall]
+        pts = hits.origin.astype(np.float32) + d_wall * hits.depth.reshape(-1)[wall, None]
+        colour[wall] *= wall_pattern(pts).astype(np.float32)[:, None]
+    floor = np.flatnonzero(_lookup(mesh.materials == MAT_FLOOR, tri))
     if floor.size:
         d_floor = hits.directions.reshape(-1, 3)[floor]
         pts = hits.origin.astype(np.float32) + d_floor * hits.depth.reshape(-1)[floor, None]
-        colour[floor] *= floor_pattern(pts, floor_tile)[:, None]
-    # smooth normals on curved parts (vertex normals differ): barycentric blend;
-    # flat faces keep the ray caster's face normal
-    n = hits.face_normals.reshape(-1, 3).copy()
-    corner_normals = mesh.normals.astype(np.float32)[mesh.triangles]  # (T, 3, 3)
-    curved_tri = np.abs(corner_normals - corner_normals[:, :1]).max(axis=(1, 2)) > 1e-4
-    curved = np.flatnonzero(hit & curved_tri[safe])
-    if curved.size:
-        c = corner_normals[tri[curved]]
-        uv = hits.uv.reshape(-1, 2)[curved]
-        u, v = uv[:, 0:1], uv[:, 1:2]
-        n[curved] = c[:, 0] * (1.0 - u - v) + c[:, 1] * u + c[:, 2] * v
-    d = hits.directions.reshape(-1, 3)
-    # unit length, turned towards the camera (shade the side that is seen)
-    facing = n[:, 0] * d[:, 0] + n[:, 1] * d[:, 1] + n[:, 2] * d[:, 2]
-    sign = np.where(facing > 0, np.float32(-1.0), np.float32(1.0))
-    length = np.sqrt(n[:, 0] * n[:, 0] + n[:, 1] * n[:, 1] + n[:, 2] * n[:, 2])
-    n *= (sign / np.maximum(length, np.float32(1e-6)))[:, None]
-    lx, ly, lz = (np.float32(c) for c in light)
-    lambert = np.clip(n[:, 0] * lx + n[:, 1] * ly + n[:, 2] * lz, 0.0, None)
-    intensity = np.float32(0.38) + np.float32(0.12) * n[:, 2] + np.float32(0.62) * lambert
-    out = colour * intensity[:, None]
-    out[~hit] = BACKGROUND
+        k = floor_pattern(pts, floor_tile).astype(np.float64)
+        if casters:
+            k = k * contact_shadow(pts, casters)
+        colour[floor] *= k.astype(np.float32)[:, None]
+    out = np.empty_like(colour)
+    _light_kernel(
+        tri,
+        np.ascontiguousarray(hits.uv.reshape(-1, 2)),
+        np.ascontiguousarray(hits.face_normals.reshape(-1, 3)),
+        np.ascontiguousarray(hits.directions.reshape(-1, 3)),
+        mesh.triangles,
+        np.ascontiguousarray(mesh.normals, dtype=np.float32),
+        mesh.smooth_triangles(),
+        colour,
+        np.asarray(light, dtype=np.float32),
+        out,
+    )
     image: NDArray[np.float32] = out.reshape(H, W, 3)
     return image
 

@@ -82,7 +82,8 @@ class ObstacleKind(enum.Enum):
 
     The thesis' obstacles (seed 000, 7.1) occlude people: box, pillar, table, chair, sofa.
     Coat stand, plant, cabinet and mannequin are person-sized clutter for the stress
-    scenarios ``static_clutter`` and ``moving_clutter``.
+    scenarios ``static_clutter`` and ``moving_clutter``. A door (leaf, frame and handle) stands
+    against a wall, its leaf facing +x before ``yaw_deg``; a shelf is a bookcase with books.
     """
 
     BOX = "box"
@@ -95,6 +96,8 @@ class ObstacleKind(enum.Enum):
     CABINET = "cabinet"
     PICTURE = "picture"
     MANNEQUIN = "mannequin"
+    DOOR = "door"
+    SHELF = "shelf"
 
 
 #: Default (length x, width y, height z) in metres per kind.
@@ -109,6 +112,8 @@ DEFAULT_SIZES: dict[ObstacleKind, tuple[float, float, float]] = {
     ObstacleKind.CABINET: (0.5, 0.9, 1.85),
     ObstacleKind.PICTURE: (0.03, 0.8, 0.6),
     ObstacleKind.MANNEQUIN: (0.5, 0.5, 1.75),
+    ObstacleKind.DOOR: (0.06, 0.95, 2.05),
+    ObstacleKind.SHELF: (0.35, 0.9, 1.9),
 }
 
 DEFAULT_COLOURS: dict[ObstacleKind, Colour] = {
@@ -122,6 +127,8 @@ DEFAULT_COLOURS: dict[ObstacleKind, Colour] = {
     ObstacleKind.CABINET: (175, 170, 160),
     ObstacleKind.PICTURE: (60, 90, 140),
     ObstacleKind.MANNEQUIN: (200, 180, 160),
+    ObstacleKind.DOOR: (150, 112, 72),
+    ObstacleKind.SHELF: (186, 150, 108),
 }
 
 
@@ -218,6 +225,18 @@ class Person(_Model):
         "stay", description="after the last waypoint: keep standing or disappear"
     )
     clothes: list[ClothesChange] = Field(default_factory=list)
+    # What the person looks like beyond the colours above; each one left out is drawn from
+    # the person's own random stream (rgbd_eval.sim.people), as are the colours left out.
+    sex: float | None = Field(None, ge=0.0, le=1.0, description="0 female .. 1 male")
+    age: float | None = Field(None, ge=18.0, le=80.0, description="years")
+    weight: float | None = Field(None, ge=0.0, le=1.0, description="build, 0.5 average")
+    muscle: float | None = Field(None, ge=0.0, le=1.0, description="0.5 average")
+    top: Literal["tshirt", "shirt", "sweater", "jacket", "dress"] | None = None
+    bottom: Literal["trousers", "jeans", "shorts", "skirt"] | None = None
+    pattern: Literal["plain", "stripes", "check", "dots", "weave"] | None = Field(
+        None, description="of the top"
+    )
+    hair_style: Literal["short", "long", "bald"] | None = None
 
     @model_validator(mode="after")
     def _check(self) -> Person:
@@ -225,6 +244,8 @@ class Person(_Model):
             _check_colour(name, getattr(self, name))
         if bool(self.path) == (self.follow is not None):
             raise ValueError(f"person {self.id}: give either a non-empty path or follow, not both")
+        if self.top == "dress" and self.bottom is not None:
+            raise ValueError(f"person {self.id}: a dress has no bottom (bottom: {self.bottom})")
         times = [c.at_s for c in self.clothes]
         if times != sorted(times):
             raise ValueError(
@@ -305,6 +326,13 @@ class Sensor(_Model):
     dark_dropout: float = Field(0.25, ge=0.0, le=1.0, description="P(invalid) on dark surfaces")
     shiny_dropout: float = Field(0.35, ge=0.0, le=1.0, description="P(invalid) on shiny surfaces")
     rgb_noise_std: float = Field(2.5, ge=0.0, le=50.0, description="RGB pixel noise (levels)")
+    rgb_blur_px: float = Field(
+        0.6,
+        ge=0.0,
+        le=5.0,
+        description="Gaussian blur (sigma, pixels) of the colour image: the Kinect's lens and "
+        "Bayer demosaicing; 0 for a sharp image",
+    )
     exposure_amplitude: float = Field(
         0.08, ge=0.0, le=0.8, description="relative amplitude of slow exposure changes"
     )

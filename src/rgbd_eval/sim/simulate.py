@@ -8,19 +8,17 @@ only on the seed and the frame index: same scenario and seed, same bytes.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.sim import rig
 from rgbd_eval.sim.annotate import person_ground_truth
-from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.meshes import MAT_SHINY, MAT_SKIN, Mesh, concatenate
 from rgbd_eval.sim.motion import (
-    STRIDE_PER_HEIGHT,
     clothes_at,
     follower_state,
     gait_amplitude,
@@ -30,6 +28,7 @@ from rgbd_eval.sim.motion import (
     robot_timeline,
 )
 from rgbd_eval.sim.odometry import integrate_odometry
+from rgbd_eval.sim.people import dress, look_of
 from rgbd_eval.sim.render import (
     CameraCast,
     Hits,
@@ -100,7 +99,8 @@ class Simulator:
         self.base_to_link = rig.base_to_camera_link(scenario.robot)
         self.link_to_rgb = rig.camera_link_to_rgb()
         self.link_to_depth = rig.camera_link_to_depth(s)
-        self.static = static_mesh(scenario.room, scenario.obstacles)
+        static = static_mesh(scenario.room, scenario.obstacles)
+        self.static = replace(static, smooth=static.smooth_triangles())  # once, not per frame
         self._static_scene = make_scene(self.static)
         #: Static-scene casts per camera model (size, intrinsics and frame id), with the pose
         #: they were cast from.
@@ -157,22 +157,17 @@ class Simulator:
             if not st.present:
                 continue
             shirt, trousers = clothes_at(person, t)
-            outfit = Outfit(
-                shirt,
-                trousers,
-                person.skin,
-                person.hair,
-                person.shoes,
+            dressed = dress(*look_of(person, self.seed, shirt, trousers))
+            mesh, top = dressed.mesh(
+                st.x,
+                st.y,
+                st.heading,
+                st.distance / dressed.stride(st.speed),
+                st.speed,
+                gait_amplitude(driver, segs, t),
+                st.sit,
+                person.id,
                 person.bag_colour if person.bag else None,
-            )
-            stride = STRIDE_PER_HEIGHT * person.height
-            posture = Posture(
-                phase=2.0 * math.pi * st.distance / stride,
-                amplitude=gait_amplitude(driver, segs, t),
-                sit=st.sit,
-            )
-            mesh, top = figure_mesh(
-                person.height, st.x, st.y, st.heading, posture, outfit, person.id
             )
             out.append((person.id, mesh, top, (st.x, st.y)))
         return out
@@ -219,7 +214,16 @@ class Simulator:
         # RGB: shaded colour and the id buffer used for visibility
         mesh = concatenate([self.static, people_mesh])
         hits = self._render(people_scene, self.rgb_camera, rgb_pose)
-        clean = shade(mesh, hits, self.light, sc.room.floor_tile)
+        casters = [(xy[0], xy[1], 0.3) for _, _, _, xy in people]
+        clean = shade(mesh, hits, self.light, sc.room.floor_tile, casters)
+        if s.rgb_blur_px > 0.0:  # the lens and the Bayer demosaic soften the image
+            clean = np.stack(
+                [
+                    exact.gaussian_filter(clean[..., k].astype(np.float64), s.rgb_blur_px)
+                    for k in range(3)
+                ],
+                axis=-1,
+            ).astype(np.float32)
         ids = object_ids(mesh, hits)
         gain = exposure_gain(t, s.exposure_amplitude, s.exposure_period_s) * s.illumination
         noise = frame_noise(self._noise, _rng(self.seed, _STREAM_RGB, index))

@@ -81,7 +81,7 @@ def container_for(out_path: Path | str) -> SynthContainer:
 
 #: Bumped whenever rendering changes the bytes on purpose (tests/sim/test_determinism.py pins
 #: them): two recordings of the same provenance must then be the same bytes.
-RENDERER_VERSION = 2
+RENDERER_VERSION = 3
 
 
 def provenance(

@@ -7,23 +7,23 @@ obstacle ``i``; people use their own ids (1..10000); :data:`NO_HIT` is empty spa
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 
 from rgbd_eval import exact
-from rgbd_eval.sim.figure import Outfit, Posture, figure_mesh
 from rgbd_eval.sim.meshes import (
     F64,
     MAT_FLOOR,
     MAT_MATTE,
     MAT_SHINY,
+    MAT_WALL,
     Mesh,
     MeshBuilder,
     rotation_x,
     rotation_z,
 )
-from rgbd_eval.sim.scenario import Obstacle, ObstacleKind, Room
+from rgbd_eval.sim.people import CLOTH_COLOURS
+from rgbd_eval.sim.scenario import Colour, Obstacle, ObstacleKind, Room
 
 ROOM_ID = 0
 OBSTACLE_ID_BASE = 1_000_000
@@ -53,7 +53,7 @@ def room_mesh(room: Room, b: MeshBuilder) -> None:
         ((cx, room.y_min - t / 2, h / 2), (lx, t, h)),
         ((cx, room.y_max + t / 2, h / 2), (lx, t, h)),
     ):
-        b.box(centre, size, np.eye(3), wall, ROOM_ID)
+        b.box(centre, size, np.eye(3), wall, ROOM_ID, MAT_WALL)
         # skirting: a 8 cm strip standing 1 cm proud of the wall
         sc = (centre[0], centre[1], 0.04)
         ss = (size[0] + 0.02, size[1] + 0.02, 0.08)
@@ -164,17 +164,83 @@ def obstacle_mesh(ob: Obstacle, object_id: int, b: MeshBuilder) -> None:
             handle = at(sx / 2 + 0.02, iy * 0.05, sz / 2 + 0.05)
             b.box(handle, (0.02, 0.015, 0.15), R, (60, 60, 60), object_id, MAT_SHINY)
     elif kind is ObstacleKind.MANNEQUIN:
-        # a shop dummy: the walking figures' body in one plastic colour (no hair, no
-        # clothes edges) standing still on a round base plate
-        plastic = ob.rgb
-        outfit = Outfit(plastic, plastic, plastic, plastic, plastic)
-        figure, _top = figure_mesh(
-            sz, ob.x, ob.y, math.radians(ob.yaw_deg), Posture(), outfit, object_id
-        )
-        b.extend(replace(figure, vertices=figure.vertices + np.array([0.0, 0.0, ob.z])))
+        # a shop dummy: a person's body (no hair, no face, no clothes) in one plastic colour,
+        # standing on a round base plate
+        b.extend(mannequin_mesh(sz, ob.x, ob.y, ob.z, math.radians(ob.yaw_deg), ob.rgb, object_id))
         b.cylinder(o, min(sx, sy) / 2 - 0.02, 0.02, _f(ob.rgb, 0.5), object_id, MAT_SHINY)
+    elif kind is ObstacleKind.DOOR:
+        frame = _f(ob.rgb, 0.7)
+        b.box(at(0, 0, sz / 2), (sx, sy - 0.1, sz - 0.05), R, col, object_id, mat)  # the leaf
+        for iy in (-1, 1):  # the frame: two jambs and a head
+            b.box(
+                at(0.01, iy * (sy / 2 - 0.025), sz / 2), (sx + 0.02, 0.05, sz), R, frame, object_id
+            )
+        b.box(at(0.01, 0, sz - 0.025), (sx + 0.02, sy, 0.05), R, frame, object_id)
+        b.box(
+            at(sx / 2 + 0.02, sy / 2 - 0.14, 1.0),
+            (0.03, 0.12, 0.02),
+            R,
+            (170, 170, 175),
+            object_id,
+            MAT_SHINY,
+        )
+    elif kind is ObstacleKind.SHELF:
+        side = _f(ob.rgb, 0.85)
+        for iy in (-1, 1):
+            b.box(at(0, iy * (sy / 2 - 0.01), sz / 2), (sx, 0.02, sz), R, side, object_id, mat)
+        b.box(at(-sx / 2 + 0.005, 0, sz / 2), (0.01, sy, sz), R, side, object_id, mat)
+        levels = 5
+        rng = np.random.default_rng(int(abs(ob.x * 1000.0) + abs(ob.y * 7919.0)) % (2**31))
+        for k in range(levels + 1):
+            z0 = 0.05 + k * (sz - 0.07) / levels
+            b.box(at(0, 0, z0), (sx, sy - 0.04, 0.02), R, col, object_id, mat)
+            if k == levels:
+                break
+            y = -sy / 2 + 0.03
+            room = (sz - 0.07) / levels - 0.04
+            while y < sy / 2 - 0.06:  # books of assorted sizes and colours
+                w = float(rng.uniform(0.02, 0.05))
+                h = room * float(rng.uniform(0.6, 0.95))
+                d = sx * float(rng.uniform(0.6, 0.9))
+                colour = _f(CLOTH_COLOURS[int(rng.integers(len(CLOTH_COLOURS)))])
+                b.box(
+                    at(-sx / 2 + d / 2 + 0.01, y + w / 2, z0 + 0.01 + h / 2),
+                    (d, w, h),
+                    R,
+                    colour,
+                    object_id,
+                    mat,
+                )
+                y += w + float(rng.uniform(0.0, 0.01))
     else:  # pragma: no cover - exhaustive over ObstacleKind
         raise ValueError(f"unknown obstacle kind {kind}")
+
+
+def mannequin_mesh(
+    height: float, x: float, y: float, z: float, yaw: float, colour: Colour, object_id: int
+) -> Mesh:
+    """A standing MakeHuman body of ``height`` (clamped to 1.5-1.95 m) in one colour."""
+    from rgbd_eval.sim.body import BodyModel, BodyShape, stand_pose, vertex_normals
+
+    model = BodyModel.load()
+    body = model.shaped(BodyShape(sex=0.5, age_years=30.0, height_m=min(max(height, 1.5), 1.95)))
+    skin = model.face_group == 0
+    faces = model.faces[skin].astype(np.int32)
+    v = body.posed(stand_pose(body))
+    v[:, 2] += 0.02 - float(v[:, 2].min())  # on the 2 cm base plate
+    s, c = exact.sincos(yaw)
+    world = np.stack(
+        [c * v[:, 0] - s * v[:, 1] + x, s * v[:, 0] + c * v[:, 1] + y, v[:, 2] + z], axis=1
+    )
+    n = len(faces)
+    return Mesh(
+        world,
+        vertex_normals(world, faces),
+        faces,
+        np.tile(np.asarray(colour, dtype=np.float64), (n, 1)),
+        np.full(n, object_id, dtype=np.int32),
+        np.full(n, MAT_MATTE, dtype=np.int32),
+    )
 
 
 def static_mesh(room: Room, obstacles: list[Obstacle]) -> Mesh:

@@ -42,9 +42,12 @@ class Silhouette:
     Proportions (in body heights) of an adult, by the classic rules of thumb: the head
     0.13 tall (about 1/7.5 of the height) and 0.10 wide, the torso from the chin to the
     crotch (0.13 .. 0.52 from the top) 0.26 wide at the shoulders, the legs below it 0.18
-    wide together. One ellipse from head to feet does not fit: it narrows at the
-    shoulders, where a person is widest, and the best-scoring size came out 20% small
-    on rendered people; head, torso and legs ellipses fit within 6%.
+    wide together. One ellipse from head to feet narrows at the shoulders, where a person
+    is widest: on the articulated mannequins of renderer version 2 its best-scoring size
+    came out 20% small, head, torso and legs ellipses within 6%. On the MakeHuman people
+    of version 3 (six people, ``tests/track/test_thermal_pf.py``) both fit: sizes
+    1.00-1.12 of the true height for these ellipses, 0.78-1.02 for one ellipse; the
+    proportions above were not changed (they are not fitted to either).
     """
 
     points: F64  # (N, 2)

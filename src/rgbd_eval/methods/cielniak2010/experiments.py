@@ -30,6 +30,7 @@ from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.types import Box2D
+from rgbd_eval.verdicts import Verdict
 
 #: The summary measures shown per ablation variant.
 MEASURES = ("mota", "motp", "idf1", "id_switches", "fn_rate", "fp_rate")
@@ -310,7 +311,10 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
     return ReproduceResult(
         markdown=render(paper, data, claims),
         data=data,
-        claims=tuple((c.sentence, bool(c.held)) for c in claims),
+        claims=tuple(
+            (c.sentence, Verdict.INCONCLUSIVE if c.held is None else Verdict.of(c.held))
+            for c in claims
+        ),
     )
 
 

@@ -63,7 +63,7 @@ class Satake2009DetectorConfig(ComponentConfig):
     min_score: float = Field(0.8, ge=0.0, le=1.0, description="least evaluation value kept")
     nms_iou: float = Field(0.3, ge=0.0, le=1.0, description="overlap that suppresses a match")
     min_head_torso_chroma: float = Field(
-        6.0, ge=0.0, le=100.0, description="colour test: head vs torso (a*, b*) distance (0: off)"
+        2.7, ge=0.0, le=100.0, description="colour test: head vs torso (a*, b*) distance (0: off)"
     )
 
     @property

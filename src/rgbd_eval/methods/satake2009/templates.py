@@ -1,8 +1,10 @@
 """Distance templates of satake2009 (seed 002, 2.2): upper-body depth templates and matching.
 
-Three templates (body turned 0, 45 and 90 degrees from the camera) are depth images of
-the synthetic figure (1.75 m) standing 2 m from a camera at 1.2 m height (the paper made
-theirs with the person 2 m away), cut from the top of the head to the hips. Each keeps
+Three templates (body turned 0, 45 and 90 degrees from the camera; the seed says three
+directions, not which) are depth images of people standing 2 m from a camera at 1.2 m
+height (the seed: "the target person was at 2m away from the camera"), cut from the top of
+the head to the hips. The people are tuning bodies no scenario scores
+(:func:`tuning_bodies`), merged into one template per direction. Each keeps
 a mask and its depth relative to the person's distance ``D`` (median depth of the mask),
 at the focal length :data:`F_REF`. For a searched distance ``D`` a template is scaled in
 size by ``(fx / F_REF) * (2 / D)`` and in depth by adding ``D`` (:func:`scale_template`).
@@ -20,16 +22,22 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import cv2
 import numpy as np
 from numpy.typing import NDArray
 
 from rgbd_eval.types import CameraModel, Pose
+
+if TYPE_CHECKING:
+    from rgbd_eval.sim.body import BodyShape
+    from rgbd_eval.sim.people import Appearance
 
 DATA = Path(__file__).resolve().parent / "templates.npz"
 #: Focal length (px) the templates are stored at: a 100-degree camera 512 px wide.
@@ -41,7 +49,11 @@ DFT_MIN_PIXELS = 4096
 #: Body orientations of the three templates (degrees from facing the camera).
 ORIENTATIONS = (0.0, 45.0, 90.0)
 _CAMERA_HEIGHT = 1.2
-_FIGURE_HEIGHT = 1.75
+#: The random stream of the bodies the templates merge (see :func:`tuning_bodies`).
+TUNING_SEED = 2009
+TUNING_STREAM = 20
+#: Image row the bodies' head tops are aligned on before merging.
+TOP_ROW = 100
 
 
 @dataclass(frozen=True)
@@ -76,10 +88,54 @@ class DistanceTemplate:
         return got
 
 
-def build_templates() -> list[DistanceTemplate]:
-    """Render the three templates from the synthetic figure at :data:`D_REF` (Open3D)."""
-    from rgbd_eval.sim.figure import HIP_Z, Outfit, Posture, figure_mesh
+def tuning_bodies() -> list[tuple[BodyShape, Appearance]]:
+    """The people the templates are made from (none of them is scored).
+
+    Six bodies spanning sex and height: a woman and a man at each of -1, 0 and +1 standard
+    deviations of the renderer's adult heights (:data:`rgbd_eval.sim.people.HEIGHT_MEAN`,
+    ``HEIGHT_SD``: 1.565, 1.63, 1.695 m and 1.69, 1.76, 1.83 m). Their age, build, hair and
+    clothes are drawn by the renderer's own catalogues from ``default_rng([TUNING_SEED,
+    TUNING_STREAM, k])``: scored people come from stream :data:`rgbd_eval.sim.people.STREAM`
+    (7), never :data:`TUNING_STREAM`, so no scenario of any seed holds one of them. Nothing
+    here is chosen by a detection score.
+    """
+    from rgbd_eval.sim.people import HEIGHT_MEAN, HEIGHT_SD, draw_appearance, draw_shape
+
+    out = []
+    for k, (sex, z) in enumerate((s, z) for s in (0, 1) for z in (-1.0, 0.0, 1.0)):
+        rng = np.random.default_rng([TUNING_SEED, TUNING_STREAM, k])
+        height = round(HEIGHT_MEAN[sex] + z * HEIGHT_SD[sex], 3)
+        shape = draw_shape(rng, float(sex), height)
+        out.append((shape, draw_appearance(rng, shape)))
+    return out
+
+
+def _render_body(
+    shape: BodyShape, look: Appearance, angle: float, cam: CameraModel, pose: Pose
+) -> tuple[NDArray[np.float64], float, float]:
+    """Depth (NaN: no body) of one standing person at :data:`D_REF`, turned ``angle`` deg,
+    with its head-top and hip heights (m)."""
+    from rgbd_eval.sim.people import dress
     from rgbd_eval.sim.render import make_scene, render_hits
+
+    person = dress(shape, look)
+    heading = math.pi - math.radians(angle)  # facing the camera at angle 0
+    mesh, top = person.mesh(D_REF, 0.0, heading, 0.0, 0.0, 0.0, 0.0, 1)
+    hip = 0.5 * float(
+        person.body.bone_head("upperleg01.L")[2] + person.body.bone_head("upperleg01.R")[2]
+    )
+    z = np.asarray(render_hits(make_scene(mesh), cam, pose).depth, np.float64)
+    return z, top, hip
+
+
+def build_templates() -> list[DistanceTemplate]:
+    """The three templates: :func:`tuning_bodies` at :data:`D_REF`, standing, merged.
+
+    Each body's depth image is shifted so that its head top falls on one row (the
+    template's anchor), then a pixel is in the mask when at least half the bodies cover
+    it, and its relative depth is the median over the bodies that do (each body's depth
+    less its own median). Cut from the head top to the bodies' median hip row.
+    """
     from rgbd_eval.types import OPTICAL_TO_BODY
 
     w, h = 512, 384
@@ -87,26 +143,41 @@ def build_templates() -> list[DistanceTemplate]:
     body = np.eye(4)
     body[2, 3] = _CAMERA_HEIGHT
     pose = Pose.from_matrix(body).compose(OPTICAL_TO_BODY)
-    outfit = Outfit((128, 128, 128), (60, 60, 60), (200, 160, 130), (40, 30, 20), (20, 20, 20))
+    bodies = tuning_bodies()
     out = []
     for angle in ORIENTATIONS:
-        heading = math.pi - math.radians(angle)  # facing the camera at angle 0
-        mesh, top = figure_mesh(_FIGURE_HEIGHT, D_REF, 0.0, heading, Posture(), outfit, 1)
-        z = render_hits(make_scene(mesh), cam, pose).depth
-        hip_row = cam.cy + F_REF * (_CAMERA_HEIGHT - HIP_Z * _FIGURE_HEIGHT) / D_REF
-        top_row = cam.cy + F_REF * (_CAMERA_HEIGHT - top) / D_REF
+        covered = np.zeros((len(bodies), h, w), bool)
+        rel = np.full((len(bodies), h, w), np.nan)
+        hips = []
+        for i, (shape, look) in enumerate(bodies):
+            z, top, hip = _render_body(shape, look, angle, cam, pose)
+            # head top of this body to row TOP_ROW: shift the image by whole pixels
+            top_row = cam.cy + F_REF * (_CAMERA_HEIGHT - top) / D_REF
+            shift = TOP_ROW - round(top_row)
+            z = np.roll(z, shift, axis=0)
+            if shift > 0:
+                z[:shift] = np.nan
+            elif shift < 0:
+                z[shift:] = np.nan
+            body_px = np.isfinite(z)
+            covered[i] = body_px
+            rel[i] = np.where(body_px, z - np.median(z[body_px]), np.nan)
+            hips.append(cam.cy + F_REF * (_CAMERA_HEIGHT - hip) / D_REF + shift)
+        hip_row = float(np.median(hips))
         rows = np.arange(h)[:, None]
-        mask = np.isfinite(z) & (rows <= hip_row)
+        mask = (2 * covered.sum(axis=0) >= len(bodies)) & (rows <= hip_row)
         r, c = np.nonzero(mask)
         r0, r1, c0, c1 = r.min(), r.max() + 1, c.min(), c.max() + 1
         pad = max(2, (c1 - c0) // 4)  # a margin around the body to see it stand free
-        c0, c1, r1 = c0 - pad, c1 + pad, r1
-        r0 = r0 - pad
+        c0, c1, r0 = c0 - pad, c1 + pad, r0 - pad
         m = mask[r0:r1, c0:c1]
-        d = np.where(m, z[r0:r1, c0:c1], np.nan).astype(np.float32)
-        dist = float(np.nanmedian(d))
-        anchor = (float(cam.cx - c0), float(top_row - r0))
-        out.append(DistanceTemplate(angle, m, (d - dist).astype(np.float32), anchor, 0.0))
+        with warnings.catch_warnings():  # all-NaN columns lie outside the mask
+            warnings.simplefilter("ignore", RuntimeWarning)
+            med = np.nanmedian(rel[:, r0:r1, c0:c1], axis=0)
+        d = np.where(m, med, np.nan)
+        d = (d - np.nanmedian(d)).astype(np.float32)  # relative to the template's median
+        anchor = (float(cam.cx - c0), float(TOP_ROW - r0))
+        out.append(DistanceTemplate(angle, m, d, anchor, 0.0))
     return out
 
 

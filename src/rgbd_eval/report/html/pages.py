@@ -29,6 +29,7 @@ from rgbd_eval.report.html.render import data_uri, jpeg_uri, render
 from rgbd_eval.report.html.video import Progress, overlay, write_overlay_video
 from rgbd_eval.report.run import COLUMNS, format_value, run_notes, table_header, table_rows
 from rgbd_eval.types import GroundTruthObject, TrackOutput
+from rgbd_eval.verdicts import Verdict
 
 if TYPE_CHECKING:
     from rgbd_eval.bench import BenchResult
@@ -409,7 +410,7 @@ class ClaimRow:
     """One claim of the paper on the page."""
 
     text: str
-    held: bool
+    verdict: Verdict
     source: str = ""
     evidence: str = ""
 
@@ -433,9 +434,9 @@ def _claims(result: ReproduceResult) -> list[ClaimRow]:
                 if c.get(key):
                     details[str(c[key])] = c
     rows = []
-    for text, held in result.claims:
+    for text, verdict in result.verdicts():
         d = details.get(text, {})
-        rows.append(ClaimRow(text, held, str(d.get("source", "")), str(d.get("evidence", ""))))
+        rows.append(ClaimRow(text, verdict, str(d.get("source", "")), str(d.get("evidence", ""))))
     return rows
 
 

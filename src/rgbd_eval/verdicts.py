@@ -1,0 +1,76 @@
+"""Verdicts on a paper's claims: held, failed, or inconclusive over several runs (issue 31).
+
+A claim judged on one run says as much about that run's people, paths and noise as about
+the method. Judged on several runs (scenario seeds that draw other people and noise), a
+claim is *held* when it holds on every run, *failed* when it fails on every run, and
+*inconclusive* when the runs disagree: a verdict that flips with the seed is never held.
+A single run gives held or failed, and says that it is one run.
+"""
+
+from __future__ import annotations
+
+import enum
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+
+class Verdict(enum.Enum):
+    """What ``reproduce`` says of one claim."""
+
+    HELD = "held"
+    FAILED = "failed"
+    INCONCLUSIVE = "inconclusive"
+
+    @staticmethod
+    def of(held: bool) -> Verdict:
+        """The verdict of one run."""
+        return Verdict.HELD if held else Verdict.FAILED
+
+
+def over_runs(held: Sequence[bool]) -> Verdict:
+    """Held on every run, failed on every run, else inconclusive (ValueError: no run)."""
+    if not held:
+        raise ValueError("a verdict needs at least one run")
+    if all(held):
+        return Verdict.HELD
+    if not any(held):
+        return Verdict.FAILED
+    return Verdict.INCONCLUSIVE
+
+
+@dataclass(frozen=True)
+class Spread:
+    """A measured value over runs: mean, least and greatest (NaN runs left out)."""
+
+    mean: float
+    low: float
+    high: float
+    runs: int
+
+    @staticmethod
+    def of(values: Sequence[float]) -> Spread:
+        """The spread of ``values`` (all NaN or none: NaN throughout, ``runs`` 0)."""
+        kept = [float(v) for v in values if not math.isnan(v)]
+        if not kept:
+            return Spread(math.nan, math.nan, math.nan, 0)
+        return Spread(math.fsum(kept) / len(kept), min(kept), max(kept), len(kept))
+
+    def text(self, fmt: str = ".3g", unit: str = "") -> str:
+        """``mean [low, high] unit over n runs``; one run: the value alone."""
+        if self.runs == 0:
+            return "-"
+        if self.runs == 1:
+            return f"{self.mean:{fmt}}{unit} (one run)"
+        return (
+            f"{self.mean:{fmt}}{unit} [{self.low:{fmt}}, {self.high:{fmt}}] over {self.runs} runs"
+        )
+
+
+def tally(verdicts: Sequence[Verdict]) -> str:
+    """``2 held, 1 failed, 1 inconclusive of 4``."""
+    n = {v: sum(1 for x in verdicts if x is v) for v in Verdict}
+    return (
+        f"{n[Verdict.HELD]} held, {n[Verdict.FAILED]} failed, "
+        f"{n[Verdict.INCONCLUSIVE]} inconclusive of {len(verdicts)}"
+    )

@@ -1,0 +1,52 @@
+"""Verdicts over runs (issue 31): a claim that flips with the seed is never held."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from rgbd_eval.plugins import ReproduceResult
+from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+
+
+def test_held_only_when_every_run_holds() -> None:
+    assert over_runs([True] * 5) is Verdict.HELD
+    assert over_runs([False] * 5) is Verdict.FAILED
+    # cielniak2010's colour claim held on tracker seeds 0-2 and failed on 3-7
+    assert over_runs([True, True, True, False, False, False, False, False]) is (
+        Verdict.INCONCLUSIVE
+    )
+    assert over_runs([True]) is Verdict.HELD
+    with pytest.raises(ValueError, match="at least one run"):
+        over_runs([])
+
+
+@given(st.lists(st.booleans(), min_size=1, max_size=12))
+def test_a_verdict_is_held_exactly_when_no_run_fails(runs: list[bool]) -> None:
+    v = over_runs(runs)
+    assert (v is Verdict.HELD) == all(runs)
+    assert (v is Verdict.FAILED) == (not any(runs))
+    # one run that disagrees with another makes any claim inconclusive
+    assert over_runs([*runs, not runs[0]]) is Verdict.INCONCLUSIVE
+
+
+def test_spread_mean_min_max_and_text() -> None:
+    # (5.7 + 8.4 + 7.3) / 3 = 7.133...
+    s = Spread.of([5.7, 8.4, 7.3, math.nan])
+    assert s.runs == 3 and s.low == 5.7 and s.high == 8.4
+    assert s.mean == pytest.approx(7.1333333)
+    assert s.text(".2f") == "7.13 [5.70, 8.40] over 3 runs"
+    assert Spread.of([2.0]).text(".1f", " %") == "2.0 % (one run)"
+    assert Spread.of([]).text() == "-" and Spread.of([math.nan]).runs == 0
+
+
+def test_tally_and_a_plugins_bool_claims_read_as_one_run() -> None:
+    r = ReproduceResult(
+        "", {}, (("a", True), ("b", False), ("c", Verdict.INCONCLUSIVE), ("d", Verdict.HELD))
+    )
+    verdicts = [v for _, v in r.verdicts()]
+    assert verdicts == [Verdict.HELD, Verdict.FAILED, Verdict.INCONCLUSIVE, Verdict.HELD]
+    assert tally(verdicts) == "2 held, 1 failed, 1 inconclusive of 4"
