@@ -10,12 +10,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 from metrics_builders import gt, track
+from scipy.optimize import linear_sum_assignment
 
 from rgbd_eval.config import EvaluationConfig
 from rgbd_eval.io.tracks import align, read_mot_gt, read_mot_tracks
 from rgbd_eval.metrics import bootstrap as boot
 from rgbd_eval.metrics import evaluate_sequence, summarize
 from rgbd_eval.metrics.frames import FrameTable
+from rgbd_eval.metrics.hota import ALPHAS
 
 PEOPLE = 10
 
@@ -266,3 +268,72 @@ def test_intervals_of_many_series_equal_each_ones_interval() -> None:
     assert boot.intervals_of(values) == {k: boot.interval(v) for k, v in values.items()}
     short = {k: v[:37] for k, v in values.items()}
     assert boot.intervals_of(short) == {k: boot.interval(v) for k, v in short.items()}
+
+
+def _straightforward(
+    table: FrameTable, w: np.ndarray, extra: dict[str, np.ndarray]
+) -> tuple[np.ndarray, float, float, np.ndarray]:
+    """One replicate of frame weights ``w``, from the table event by event: the integer
+    columns, Main Tr.'s and IDF1's true positives (a Hungarian assignment on the weighted
+    pair counts) and HOTA's association sums, each pair's term ``A^2 / max(1, G + T - A)``
+    added in the order of the pairs (ground-truth index, then track index)."""
+    t = table
+    levels = t.hota_levels()
+    ints = [
+        w[t.gt_frame].sum(),
+        w[t.track_frame].sum(),
+        w[t.match_frame].sum(),
+        w[t.match_frame[t.match_switch]].sum(),
+        w[t.match_frame[t.match_recall]].sum(),
+        *(w[t.hota_frame[levels > a]].sum() for a in range(len(ALPHAS))),
+        *((w * series).sum() for series in extra.values()),
+    ]
+    main = np.zeros((t.num_gt_tracks, t.num_tracks))
+    np.add.at(main, (t.match_gt, t.match_track), w[t.match_frame])
+    gate = np.zeros((t.num_gt_tracks, t.num_tracks))
+    np.add.at(gate, (t.potential_gt, t.potential_track), w[t.potential_frame])
+    picked = linear_sum_assignment(gate, maximize=True)
+    gt_count = np.bincount(t.gt_index, weights=w[t.gt_frame], minlength=t.num_gt_tracks)
+    track_count = np.bincount(t.track_index, weights=w[t.track_frame], minlength=t.num_tracks)
+    pairs = sorted(set(zip(t.hota_gt.tolist(), t.hota_track.tolist(), strict=True)))
+    ass = np.zeros(len(ALPHAS))
+    for a in range(len(ALPHAS)):
+        total = 0.0
+        for g, k in pairs:
+            rows = (t.hota_gt == g) & (t.hota_track == k) & (levels > a)
+            reach = w[t.hota_frame[rows]].sum()
+            total += reach * reach / max(1.0, gt_count[g] + track_count[k] - reach)
+        ass[a] = total
+    return np.array(ints), main.max(axis=1).sum(), gate[picked].sum(), ass
+
+
+@pytest.mark.parametrize("case", ["hand-made", "TUD-Campus"])
+def test_the_compiled_replicate_sums_equal_the_straightforward_ones(case: str) -> None:
+    """The kernel behind :meth:`_SequenceSums.chunk` (blocks summed, IDF1's parts tried
+    over their matchings or left to the Hungarian, HOTA's association in place) gives each
+    replicate's sums to the last bit of the straightforward computation, both ways of
+    summing, the Hungarian forced on every part too."""
+    if case == "hand-made":
+        gts, tracks = _hand_made()
+        table = evaluate_sequence(gts, tracks, EvaluationConfig()).table
+    else:
+        table, _ = _tud(case)
+    n = table.num_frames
+    extra = {"errors": boot.frame_errors(table), "none": np.zeros(n, dtype=np.int64)}
+    sums = boot._SequenceSums(table, extra)
+    hungarian = boot._SequenceSums(table, extra)
+    for part in hungarian.id_parts:
+        part.options = part.matchings = None
+    hungarian._layout, hungarian._hungarian = hungarian._kernel_layout()
+    assert hungarian._hungarian == [k for k, p in enumerate(hungarian.id_parts) if p.shape[0] > 1]
+    rng = np.random.default_rng(10)
+    for block in (1, 4, n):
+        starts = boot._draw_starts(n, block, 20, rng)
+        weights = boot._weights(n, block, starts)
+        for solver, by_blocks in ((sums, True), (sums, False), (hungarian, True)):
+            ints, _, main_tr, idtp, ass = solver.chunk(starts, block, by_blocks)
+            for r, w in enumerate(weights):
+                want = _straightforward(table, w, extra)
+                assert ints[r].tolist() == want[0].tolist()
+                assert (main_tr[r], idtp[r]) == (want[1], want[2])
+                assert ass[r].tolist() == want[3].tolist()

@@ -41,8 +41,11 @@ replicates (a stratified bootstrap), ratios again from the sums.
 Deterministic for a seed (:data:`DEFAULT_SEED`, ``evaluation.bootstrap_seed``): each
 sequence draws from ``numpy.random.default_rng([seed, crc32(name)])`` (PCG64, integer
 arithmetic). The sums are of integer counts (exact in float64, in any order, so the
-matrix products may use BLAS); the one float sum (the similarity behind MOTP) is
-summed in numpy's fixed order, never by BLAS (see :mod:`rgbd_eval.exact`).
+sparse matrix products may use any order); the float sums, the similarity behind MOTP
+and HOTA's association over its pairs, are added in a fixed order, never by BLAS (see
+:mod:`rgbd_eval.exact`). A replicate's sums, Main Tr., IDF1's assignment (but for the
+parts left to the Hungarian) and HOTA's association are one loop compiled with numba
+(:func:`_replicate_stats`), without fast-math: nothing reordered or fused.
 
 ``compare``'s paired bootstrap draws one set of replicate weights per sequence and
 applies it to both reports' tables (the same frames of the same sequence), so a
@@ -54,9 +57,10 @@ from __future__ import annotations
 
 import math
 import zlib
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 from numpy.typing import NDArray
@@ -216,16 +220,30 @@ def start_chunks(
         yield starts[done : done + per_group]
 
 
-def _window_sums(values: FloatArray, lengths: Sequence[int]) -> FloatArray:
-    """``(len(lengths) * n, columns)``: for each length L, row ``s`` holds the sums of the
-    columns of ``values`` ``(columns, n)`` over frames ``s .. s + L - 1`` (wrapping).
-    Integer counts: prefix sums and their differences are exact."""
-    width, n = values.shape
-    prefix = np.zeros((width, 2 * n + 1))
-    np.cumsum(np.concatenate([values, values], axis=1), axis=1, out=prefix[:, 1:])
-    runs = [prefix[:, length : length + n] - prefix[:, :n] for length in lengths]
-    out: FloatArray = np.ascontiguousarray(np.concatenate(runs, axis=1).T)
+def _window_sums(values: FloatArray, lengths: IntArray) -> FloatArray:
+    """``(len(lengths) * n, columns)``: for each length L (``1 <= L <= n``), row ``s`` of its
+    ``n`` rows holds the sums of the rows ``s .. s + L - 1`` of ``values`` ``(n, columns)``
+    (wrapping). A running sum (compiled, :data:`_window_sums_kernel`): integer counts, exact."""
+    n, width = values.shape
+    out = np.empty((lengths.shape[0] * n, width))
+    run = np.zeros(width)
+    for k in range(lengths.shape[0]):
+        run[:] = 0.0
+        for f in range(lengths[k]):
+            x = values[f]
+            for c in range(width):
+                run[c] += x[c]
+        for start in range(n):
+            out[k * n + start] = run
+            x, y = values[(start + lengths[k]) % n], values[start]
+            for c in range(width):
+                run[c] += x[c] - y[c]
     return out
+
+
+_window_sums_kernel: Callable[[FloatArray, IntArray], FloatArray] = numba.njit(cache=True)(
+    _window_sums
+)
 
 
 # ----------------------------------------------------------------------------- replicate sums
@@ -297,13 +315,19 @@ def maximal_matchings(
         return None
     edges: list[list[tuple[int, int]]] = [[] for _ in range(num_rows)]
     last: dict[int, int] = {}  # per column, the last row with an edge to it
+    col_rows: dict[int, list[int]] = {}  # per column, its rows
     for e, (r, c) in enumerate(zip(rows.tolist(), cols.tolist(), strict=True)):
         edges[r].append((e, c))
         last[c] = max(last.get(c, r), r)
+        col_rows.setdefault(c, []).append(r)
+    # Per row, the columns it is the last row of, with their rows.
+    closing: list[list[tuple[int, list[int]]]] = [[] for _ in range(num_rows)]
+    for c, r in last.items():
+        closing[r].append((c, col_rows[c]))
     found: list[list[int]] = []
     chosen: list[int] = []
     used: set[int] = set()
-    skipped: list[int] = []
+    skipped = [False] * num_rows
     budget = 4 * limit  # search steps: a dense part ends the search early
 
     def search(r: int) -> bool:
@@ -311,9 +335,14 @@ def maximal_matchings(
         budget -= 1
         if budget < 0 or len(found) > limit:
             return False
-        # A row left unmatched needs its free columns taken by a row from r on.
-        if any(c not in used and last[c] < r for k in skipped for _, c in edges[k]):
-            return True
+        # A row left unmatched needs its free columns taken by a row from r on. The search
+        # got here through r - 1, whose own check held: only the columns whose last row is
+        # r - 1 can fail it now.
+        for c, ks in closing[r - 1] if r else ():
+            if c not in used:
+                for k in ks:
+                    if skipped[k]:
+                        return True
         if r == num_rows:
             found.append(list(chosen))
             return True
@@ -326,9 +355,9 @@ def maximal_matchings(
                 used.discard(c)
                 if not ok:
                     return False
-        skipped.append(r)
+        skipped[r] = True
         ok = search(r + 1)
-        skipped.pop()
+        skipped[r] = False
         return ok
 
     if not search(0) or len(found) > limit:
@@ -347,20 +376,22 @@ class _AssignmentPart:
 
     def __init__(self, pairs: IntArray, rows: IntArray, cols: IntArray) -> None:
         self.pairs = pairs
-        row_ids, rows = np.unique(rows, return_inverse=True)
-        col_ids, cols = np.unique(cols, return_inverse=True)
-        shape = (len(row_ids), len(col_ids))
+        rows, cols = _dense_ids(rows), _dense_ids(cols)
+        shape = (int(rows.max()) + 1, int(cols.max()) + 1)
         if shape[0] > shape[1]:  # rows <= columns: the solver then returns rows 0, 1, ...
             rows, cols, shape = cols, rows, (shape[1], shape[0])
-        self.rows, self.cols, self.shape = rows.ravel(), cols.ravel(), shape
-        #: Per maximal matching, 1 for its edges ``(matchings, edges)``; None: the Hungarian.
+        self.rows, self.cols, self.shape = rows, cols, shape
+        #: The maximal matchings as lists of edges (indices into ``pairs``); None: the
+        #: Hungarian. ``matchings``: the same as rows of 1 for their edges ``(matchings, edges)``.
+        self.options: list[list[int]] | None = None
         self.matchings: FloatArray | None = None
         if shape[0] > 1:
-            found = maximal_matchings(self.rows, self.cols, shape[0])
-            if found is not None:
-                self.matchings = np.zeros((len(found), len(pairs)))
-                for k, edges in enumerate(found):
-                    self.matchings[k, edges] = 1.0
+            self.options = maximal_matchings(self.rows, self.cols, shape[0])
+            if self.options is not None:
+                sizes = [len(edges) for edges in self.options]
+                self.matchings = np.zeros((len(sizes), len(pairs)))
+                which = np.repeat(np.arange(len(sizes)), sizes)
+                self.matchings[which, [e for edges in self.options for e in edges]] = 1.0
 
     def best(self, counts: FloatArray) -> FloatArray:
         """The best assignment's total of every replicate (columns of ``counts``)."""
@@ -380,12 +411,21 @@ class _AssignmentPart:
         return out
 
 
+def _dense_ids(ids: IntArray) -> IntArray:
+    """Each id's rank among the distinct ids (``numpy.unique``'s inverse), for a few ids."""
+    values = ids.tolist()
+    rank = {v: k for k, v in enumerate(sorted(set(values)))}
+    return np.array([rank[v] for v in values], dtype=np.int64)
+
+
 def _assignment_parts(rows: IntArray, cols: IntArray) -> list[_AssignmentPart]:
-    """The connected parts of the bipartite graph of pairs ``(rows[i], cols[i])``."""
+    """The connected parts of the bipartite graph of pairs ``(rows[i], cols[i])``, in the
+    order of their smallest node (rows first), each with its pairs in order."""
     if not len(rows):
         return []
-    num_rows = int(rows.max()) + 1
-    parent = list(range(num_rows + int(cols.max()) + 1))
+    row_list, col_list = rows.tolist(), cols.tolist()
+    num_rows = max(row_list) + 1
+    parent = list(range(num_rows + max(col_list) + 1))
 
     def root(node: int) -> int:
         while parent[node] != node:
@@ -393,15 +433,174 @@ def _assignment_parts(rows: IntArray, cols: IntArray) -> list[_AssignmentPart]:
             node = parent[node]
         return node
 
-    for r, c in zip(rows.tolist(), cols.tolist(), strict=True):
+    for r, c in zip(row_list, col_list, strict=True):
         a, b = root(r), root(num_rows + c)
         if a != b:
             parent[max(a, b)] = min(a, b)
-    part_of = np.array([root(r) for r in rows.tolist()])
-    return [
-        _AssignmentPart(np.flatnonzero(part_of == p), rows[part_of == p], cols[part_of == p])
-        for p in np.unique(part_of)
-    ]
+    members: dict[int, list[int]] = {}
+    for i, r in enumerate(row_list):
+        members.setdefault(root(r), []).append(i)
+    parts = []
+    for p in sorted(members):
+        index = np.array(members[p], dtype=np.int64)
+        parts.append(_AssignmentPart(index, rows[index], cols[index]))
+    return parts
+
+
+# ----------------------------------------------------------------------------- compiled kernel
+
+#: Replicates the kernel works on at once: their column sums (a column per replicate)
+#: stay in cache while every loop runs along them.
+_TILE = 16
+
+
+def _replicate_stats(
+    rows: IntArray,
+    blocks: FloatArray,
+    sums: FloatArray,
+    spans: IntArray,
+    main_starts: IntArray,
+    extra_from: IntArray,
+    extra_to: IntArray,
+    part_starts: IntArray,
+    option_starts: IntArray,
+    option_pairs: IntArray,
+    level_pair: IntArray,
+    level_rows: IntArray,
+    pair_gt: IntArray,
+    pair_track: IntArray,
+    num_columns: int,
+    kept: IntArray,
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """What :meth:`_SequenceSums.chunk` derives from each replicate's column sums, compiled
+    (:data:`_replicate_stats_kernel`), :data:`_TILE` replicates at a time.
+
+    A replicate's column sums are those of its blocks, the rows ``rows[r]`` of ``blocks``
+    added, or (``rows`` without columns) ``sums[r]``. Returns the frame-level integer
+    columns ``(num_columns, replicates)``, Main Tr.'s matches, IDF1's IDTP of the parts
+    solved here, HOTA's association sums ``(19, replicates)`` and the sums of the columns
+    ``kept`` ``(len(kept), replicates)`` (for the parts left to the Hungarian).
+
+    ``spans``: the first and end column of the ground-truth counts, of the track counts and
+    of the matches per pair, the column of ID switches (recall errors next) and the first
+    (level, pair) column. ``main_starts``: the first match column of each ground-truth id,
+    and the end. ``extra_from`` -> ``extra_to``: the caller's columns. IDF1: part ``p`` is
+    the best of its options ``part_starts[p]`` to ``part_starts[p + 1] - 1``, option ``o``
+    the sum of the columns ``option_pairs[option_starts[o]:option_starts[o + 1]]`` (a
+    maximal matching, or one pair of a part with one row). HOTA: the (level, pair) columns
+    sorted by level, ``level_rows[l]`` to ``level_rows[l + 1] - 1`` those of level ``l``,
+    ``level_pair`` their pair, whose ground-truth and track count columns are ``pair_gt``
+    and ``pair_track``.
+
+    Every sum is of integer counts (exact in any order) but HOTA's association, whose
+    terms (each one IEEE division) are added pair after pair, as numpy's ``add.reduce``
+    over the pairs adds them. Loops run along the replicates (one replicate per lane of
+    the vector instructions, its own operations in the same order): no fast-math, nothing
+    reordered within a replicate, the same bits on every CPU.
+    """
+    from_blocks = rows.shape[1] > 0
+    count = rows.shape[0] if from_blocks else sums.shape[0]
+    width = blocks.shape[1] if from_blocks else sums.shape[1]
+    n_alpha = level_rows.shape[0] - 2
+    num_pairs = pair_gt.shape[0]
+    ints = np.zeros((num_columns, count))
+    main_tr = np.zeros(count)
+    idtp = np.zeros(count)
+    ass = np.zeros((n_alpha, count))
+    kept_sums = np.zeros((kept.shape[0], count))
+    tile = np.zeros((width, _TILE))
+    one = np.zeros(width)
+    best = np.zeros(_TILE)
+    total = np.zeros(_TILE)
+    both = np.zeros((num_pairs, _TILE))
+    reach = np.zeros((num_pairs, _TILE))
+    term = np.zeros((num_pairs, _TILE))
+    for first in range(0, count, _TILE):
+        m = min(_TILE, count - first)
+        # The tile's column sums, one column per replicate.
+        for j in range(m):
+            if from_blocks:
+                one[:] = 0.0
+                for i in range(rows.shape[1]):
+                    x = blocks[rows[first + j, i]]
+                    for c in range(width):
+                        one[c] += x[c]
+            else:
+                one[:] = sums[first + j]
+            tile[:, j] = one
+        # (Inner loops over the tile's replicates ``j`` read rows of 2-d arrays as 1-d views:
+        # those loops are vectorised.)
+        for k in range(3):  # ground truth, tracks, matches: totals
+            out = ints[k, first : first + m]
+            for c in range(spans[2 * k], spans[2 * k + 1]):
+                x = tile[c]
+                for j in range(m):
+                    out[j] += x[j]
+        for k in range(2):  # ID switches, recall errors
+            ints[3 + k, first : first + m] = tile[spans[6] + k, :m]
+        for i in range(extra_from.shape[0]):
+            ints[extra_to[i], first : first + m] = tile[extra_from[i], :m]
+        for i in range(kept.shape[0]):
+            kept_sums[i, first : first + m] = tile[kept[i], :m]
+        # Main Tr.: each ground-truth id's best track.
+        out = main_tr[first : first + m]
+        for g in range(main_starts.shape[0] - 1):
+            best[:] = 0.0
+            for c in range(main_starts[g], main_starts[g + 1]):
+                x = tile[c]
+                for j in range(m):
+                    best[j] = max(best[j], x[j])
+            for j in range(m):
+                out[j] += best[j]
+        # IDF1: each part's best option.
+        out = idtp[first : first + m]
+        for p in range(part_starts.shape[0] - 1):
+            best[:] = 0.0
+            for o in range(part_starts[p], part_starts[p + 1]):
+                total[:] = 0.0
+                for i in range(option_starts[o], option_starts[o + 1]):
+                    x = tile[option_pairs[i]]
+                    for j in range(m):
+                        total[j] += x[j]
+                for j in range(m):
+                    best[j] = max(best[j], total[j])
+            for j in range(m):
+                out[j] += best[j]
+        # HOTA, one threshold at a time from the highest: a pair reaches threshold a with
+        # its matches of the levels above a; its term reach^2 / max(1, gt + track - reach)
+        # changes only where its reach does; the terms summed in pair order.
+        for q in range(num_pairs):
+            x, y, z = tile[pair_gt[q]], tile[pair_track[q]], both[q]
+            for j in range(m):
+                z[j] = x[j] + y[j]
+        reach[:] = 0.0
+        term[:] = 0.0
+        total[:] = 0.0  # the matches reaching the threshold: HOTA's TP
+        for a in range(n_alpha - 1, -1, -1):
+            lo, hi = level_rows[a + 1], level_rows[a + 2]
+            out = ass[a, first : first + m]
+            if hi > lo or a == n_alpha - 1:
+                for i in range(lo, hi):
+                    q = level_pair[i]
+                    x, z, held, t = tile[spans[7] + i], both[q], reach[q], term[q]
+                    for j in range(m):
+                        total[j] += x[j]
+                        v = held[j] + x[j]
+                        held[j] = v
+                        t[j] = v * v / max(z[j] - v, 1.0)
+                for q in range(num_pairs):
+                    t = term[q]
+                    for j in range(m):
+                        out[j] += t[j]
+            else:
+                out[:] = ass[a + 1, first : first + m]
+            ints[5 + a, first : first + m] = total[:m]
+    return ints, main_tr, idtp, ass, kept_sums
+
+
+_replicate_stats_kernel: Callable[
+    ..., tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]
+] = numba.njit(cache=True)(_replicate_stats)
 
 
 class _Design:
@@ -436,6 +635,17 @@ class _Design:
         self.data.append(values[cols, frames].astype(np.float64))
         out = slice(self.width, self.width + len(values))
         self.width += len(values)
+        return out
+
+    def dense(self) -> FloatArray:
+        """The design frame by frame, dense ``(frames, columns)``: :meth:`matrix`
+        transposed (integer counts added: exact)."""
+        rows = np.concatenate(self.rows) if self.rows else np.zeros(0, dtype=np.int64)
+        cols = np.concatenate(self.cols) if self.cols else np.zeros(0, dtype=np.int64)
+        data = np.concatenate(self.data) if self.data else np.zeros(0)
+        size = self.width * self.num_frames
+        flat = np.bincount(rows * self.width + cols, weights=data, minlength=size)
+        out: FloatArray = flat.astype(np.float64, copy=False).reshape(self.num_frames, self.width)
         return out
 
     def matrix(self) -> sparse.csr_matrix:
@@ -493,38 +703,80 @@ class _SequenceSums:
         self.hota_pair_gt = pairs // num_tracks
         self.hota_pair_track = pairs % num_tracks
         self.similarity = t.per_frame(t.match_frame, t.match_value).astype(np.float64)
-        self.design = design.matrix()
+        self._design = design
+        self._matrix: sparse.csr_matrix | None = None
+        self.num_columns = design.width
         self.num_frames = t.num_frames
         self._block_counts: dict[tuple[int, int], FloatArray] = {}
         self._block_similarity: dict[tuple[int, int], FloatArray] = {}
+        self._layout, self._hungarian = self._kernel_layout()
+
+    def _kernel_layout(self) -> tuple[tuple[IntArray | int, ...], list[int]]:
+        """:func:`_replicate_stats`' arguments after ``sums`` (the columns it reads), and the
+        IDF1 parts it leaves to the Hungarian (their indices in ``id_parts``)."""
+        spans = [self.gt_count, self.track_count, self.main]
+        flat = [x for span in spans for x in (span.start, span.stop)]
+        part_starts, option_starts, option_pairs, hungarian = [0], [0], [], []
+        for k, part in enumerate(self.id_parts):
+            columns = (self.potential.start + part.pairs).tolist()
+            if part.shape[0] == 1:
+                options = [[c] for c in columns]
+            elif part.options is not None:
+                options = [[columns[e] for e in edges] for edges in part.options]
+            else:
+                hungarian.append(k)
+                continue
+            for option in options:
+                option_pairs += option
+                option_starts.append(len(option_pairs))
+            part_starts.append(len(option_starts) - 1)
+        # The Hungarian parts take the pair counts (all of them: their ``pairs`` index those).
+        kept = range(self.potential.start, self.potential.stop) if hungarian else ()
+        main_starts = [*self.main_gt_starts.tolist(), self.main.stop - self.main.start]
+
+        def ints(values: Sequence[int] | range | IntArray) -> IntArray:
+            return np.asarray(values, dtype=np.int64)
+
+        layout = (
+            ints([*flat, self.flags.start, self.pair_levels.start]),
+            self.main.start + ints(main_starts if len(self.main_gt_starts) else [0]),
+            ints(range(self.extra.start, self.extra.stop)),
+            ints(self.extra_columns),
+            ints(part_starts),
+            ints(option_starts),
+            ints(option_pairs),
+            ints(self.level_pair),
+            ints(self.level_rows),
+            ints(self.gt_count.start + self.hota_pair_gt),
+            ints(self.track_count.start + self.hota_pair_track),
+            len(self.columns),
+            ints(kept),
+        )
+        return layout, hungarian
 
     def _last(self, block: int, k: int) -> int:
         """The length of a replicate's last block of ``k`` (cut to the first n frames)."""
         return self.num_frames - (k - 1) * block
 
-    def _picks(self, starts: IntArray) -> tuple[IntArray, sparse.csr_matrix]:
-        """Per replicate the rows of its blocks in :meth:`_blocks`' tables (``start`` for a
-        full block, ``n + start`` for the last, cut one), and them as a sparse matrix
-        ``(replicates, 2 n)``."""
-        count, k = starts.shape
-        rows = starts.copy()
+    def _rows(self, starts: IntArray) -> IntArray:
+        """Per replicate the rows of its blocks in :meth:`_blocks`' tables: ``start`` for a
+        full block, ``n + start`` for the last, cut one."""
+        rows = starts.astype(np.int64)
         rows[:, -1] += self.num_frames
-        picks = sparse.csr_matrix(
-            (np.ones(count * k), rows.ravel(), np.arange(0, count * k + 1, k)),
-            shape=(count, 2 * self.num_frames),
-        )
-        return rows, picks
+        return rows
 
     def by_blocks(self) -> bool:
         """Whether replicates are summed over their blocks (each block's counts, prepared
         once: the table of :meth:`_blocks` fits :data:`BLOCK_SUMS_MAX`), else over the frame
         weights (every event of the table times each replicate's weights). Measured on the
         TUD sequences and the demo, blocks of 1 to 40 frames, the blocks are never slower."""
-        return bool(self.design.shape[0] * 2 * self.num_frames <= BLOCK_SUMS_MAX)
+        return bool(self.num_columns * 2 * self.num_frames <= BLOCK_SUMS_MAX)
 
     def width(self, by_blocks: bool) -> int:
-        """The values held per replicate while it is summed (:func:`start_chunks`)."""
-        return int(self.design.shape[0]) + (0 if by_blocks else self.num_frames)
+        """The values held per replicate while it is summed (:func:`start_chunks`): over
+        the frame weights, its weights and its column sums; over the blocks, next to
+        nothing (the kernel sums a few replicates at a time)."""
+        return 1 if by_blocks else self.num_columns + self.num_frames
 
     def _blocks(self, block: int, k: int, by_blocks: bool | None) -> FloatArray | None:
         """The counts of the run of ``block`` frames from each frame, and of the last block's
@@ -537,7 +789,9 @@ class _SequenceSums:
         key = (block, k)
         if key not in self._block_counts:
             lengths = (block, self._last(block, k))
-            self._block_counts[key] = _window_sums(self.design.toarray(), lengths)
+            self._block_counts[key] = _window_sums_kernel(
+                self._design.dense(), np.array(lengths, dtype=np.int64)
+            )
         return self._block_counts[key]
 
     def _similarities(self, block: int, k: int) -> FloatArray:
@@ -563,60 +817,27 @@ class _SequenceSums:
         once per start), whichever is cheaper (``by_blocks``: that way): integer sums, the
         same either way. The similarity behind MOTP is summed over the blocks."""
         count, k = starts.shape
-        rows, picks = self._picks(starts)
+        rows = self._rows(starts)
         blocks = self._blocks(block, k, by_blocks)
         if blocks is None:
             # Integer counts with integer weights: exact in any summation order.
             w = _weights(self.num_frames, block, starts)
-            sums = np.asarray(self.design @ w.T)  # (columns, replicates)
+            if self._matrix is None:
+                self._matrix = self._design.matrix()
+            sums = np.ascontiguousarray(np.asarray(self._matrix @ w.T).T)  # (replicates, columns)
+            picked, blocks = np.zeros((count, 0), dtype=np.int64), np.zeros((0, 0))
         else:
-            sums = np.ascontiguousarray(np.asarray(picks @ blocks).T)
+            picked, sums = rows, np.zeros((0, 0))
+        ints, main_tr, idtp, ass, potential = _replicate_stats_kernel(
+            picked, blocks, sums, *self._layout
+        )
+        for index in self._hungarian:
+            idtp += self.id_parts[index].best(potential)
         similarity = np.add.reduce(self._similarities(block, k)[rows], axis=1)
-        gt_count, track_count = sums[self.gt_count], sums[self.track_count]
-        main = sums[self.main]
-        ints = np.zeros((len(self.columns), count))
-        ints[0] = gt_count.sum(axis=0)
-        ints[1] = track_count.sum(axis=0)
-        ints[2] = main.sum(axis=0)
-        ints[3:5] = sums[self.flags]
-        ints[self.extra_columns] = sums[self.extra]
-        main_tr = np.zeros(count)
-        if len(main):
-            main_tr = np.maximum.reduceat(main, self.main_gt_starts, axis=0).sum(axis=0)
-        potential = sums[self.potential]
-        idtp = np.zeros(count)
-        for part in self.id_parts:
-            idtp += part.best(potential)
-        ass = self._hota(sums[self.pair_levels], gt_count, track_count, ints[5 : 5 + _N_ALPHA])
+        # Transposed views, the layout the replicates have always had: ``replicate_metrics``
+        # averages HOTA over the thresholds along their rows, and numpy adds a row's values
+        # in an order that depends on the layout (the same layout, the same bits).
         return ints.T, similarity, main_tr, idtp, ass.T
-
-    def _hota(
-        self, levels: FloatArray, gt_count: FloatArray, track_count: FloatArray, tp: FloatArray
-    ) -> FloatArray:
-        """HOTA's association sums ``(19, replicates)``; ``tp`` gets the TP at each threshold
-        (the matches of a level above it). ``levels``: the (level, pair) columns' sums."""
-        count = levels.shape[1]
-        ass = np.zeros((_N_ALPHA, count))
-        if not self.num_hota_pairs:
-            return ass
-        both = gt_count[self.hota_pair_gt] + track_count[self.hota_pair_track]
-        reach = np.zeros((self.num_hota_pairs, count))
-        total = np.zeros(count)
-        num, den = np.empty_like(reach), np.empty_like(reach)
-        # One threshold at a time, from the highest: small arrays, no large temporaries.
-        for a in range(_N_ALPHA - 1, -1, -1):
-            lo, hi = self.level_rows[a + 1], self.level_rows[a + 2]
-            if hi > lo or a == _N_ALPHA - 1:  # else the same pairs reach a as a + 1
-                reach[self.level_pair[lo:hi]] += levels[lo:hi]  # the matches of level a + 1
-                total += levels[lo:hi].sum(axis=0)
-                # reach^2 / max(1, both - reach), summed over the pairs (in place: no allocations)
-                np.maximum(np.subtract(both, reach, out=den), 1.0, out=den)
-                np.divide(np.multiply(reach, reach, out=num), den, out=num)
-                np.add.reduce(num, axis=0, out=ass[a])
-            else:
-                ass[a] = ass[a + 1]
-            tp[a] = total
-        return ass
 
 
 def replicates(
@@ -684,7 +905,10 @@ def _assemble(
             np.zeros((count, _N_ALPHA)),
             blocks,
         )
-    ints, sim, main, idtp, ass = (np.concatenate(p, axis=0) for p in zip(*parts, strict=True))
+    if len(parts) == 1:  # as they are: the layout a concatenation would give
+        ints, sim, main, idtp, ass = parts[0]
+    else:
+        ints, sim, main, idtp, ass = (np.concatenate(p, axis=0) for p in zip(*parts, strict=True))
     return Replicates(columns, ints, sim, main, idtp, ass, blocks)
 
 
