@@ -431,9 +431,14 @@ def test_camera_angle_runs_each_angle_on_one_rendering() -> None:
 
 
 def test_each_seed_looks_at_its_own_part_of_a_scene() -> None:
-    assert [window_start(k, 5, 100.0) for k in range(5)] == [0.0, 20.0, 40.0, 60.0, 80.0]
+    # five runs of 7 s over 100 s: the first at the start, the last ending at the end
+    starts = [window_start(k, 5, 100.0, 7.0) for k in range(5)]
+    assert starts == pytest.approx([0.0, 23.25, 46.5, 69.75, 93.0])
+    assert window_start(0, 1, 100.0, 7.0) == 0.0
     with pytest.raises(ValueError, match="index=5"):
-        window_start(5, 5, 100.0)
+        window_start(5, 5, 100.0, 7.0)
+    with pytest.raises(ValueError, match="seconds=101"):
+        window_start(0, 5, 100.0, 101.0)
     scene = _walker_scene()  # 45 frames
     frames = list(window(scene, 0.5, 0.5))
     assert [f.index for f in frames] == list(range(15, 30))
