@@ -113,7 +113,7 @@ class DmtbsDetectorConfig(ComponentConfig):
         0.1, ge=0.0, le=1.0, description="disk radius of the closing (seed 003, 3.3: 10 cm)"
     )
     min_blob_area_m2: float = Field(
-        0.04, ge=0.0, description="smallest blob surface kept (m^2; seed 003, 3.4: small objects)"
+        0.041, ge=0.0, description="smallest blob surface kept (m^2; seed 003, 3.4: small objects)"
     )
     floor: FloorSource = Field(FloorSource.AUTO, description="where the floor plane comes from")
     floor_band_m: float = Field(0.03, gt=0.0, description="RANSAC inlier band of the floor (m)")
