@@ -397,6 +397,20 @@ class Scenario(_Model):
     description: str = ""
     duration_s: float = Field(gt=0.0, le=3600.0)
     seed: int = Field(0, ge=0, description="default seed (overridden by synthesize's seed)")
+    vary_paths_m: float = Field(
+        0.0,
+        ge=0.0,
+        le=2.0,
+        description="per seed, move each waypoint of each walking person by up to this far "
+        "(m), off obstacles and walls (rgbd_eval.sim.variation); 0: the paths as written",
+    )
+    vary_speed: float = Field(
+        0.0,
+        ge=0.0,
+        le=0.5,
+        description="per seed, scale each segment's walking speed by up to this share "
+        "(0.1: 0.9x-1.1x); 0: the speeds as written",
+    )
     room: Room = Room()
     obstacles: list[Obstacle] = Field(default_factory=list)
     people: list[Person] = Field(default_factory=list)

@@ -50,6 +50,7 @@ from rgbd_eval.sim.sensor import (
     noisy_depth,
     noisy_rgb,
 )
+from rgbd_eval.sim.variation import vary_paths
 from rgbd_eval.sim.world import NO_HIT, static_mesh
 from rgbd_eval.types import CameraModel, GroundTruthObject, Pose
 
@@ -88,10 +89,11 @@ class Simulator:
     """Renders the frames of one scenario for one seed."""
 
     def __init__(self, scenario: Scenario, seed: int | None = None) -> None:
-        self.scenario = scenario
         self.seed = scenario.seed if seed is None else int(seed)
         if self.seed < 0:
             raise ValueError(f"seed={self.seed} must be non-negative")
+        #: The scenario as this seed renders it: its paths varied (rgbd_eval.sim.variation).
+        self.scenario = scenario = vary_paths(scenario, self.seed)
         s = scenario.sensor
         self.rgb_camera: CameraModel = rig.rgb_camera(s)
         self.depth_camera_full: CameraModel = rig.depth_camera_full(s)
