@@ -86,6 +86,11 @@ def test_outside_method_runs_through_every_command(toy_recording: Path, tmp_path
     assert rep.returncode == 0, rep.stderr
     data = json.loads((tmp_path / "rep" / "reproduce.json").read_text())
     assert data["method"] == "toy" and set(data["mota"]) == {"0.25", "1.0"}
+    # The CPU time of the whole command, split (the toy experiments render nothing).
+    cpu = data["cpu_total_s"]
+    assert set(cpu) == {"generate", "experiments"} and cpu["experiments"] > 0.0
+    assert "CPU time: " in (tmp_path / "rep" / "reproduce.md").read_text()
+    assert "CPU time: " in (tmp_path / "rep" / "reproduce.html").read_text()
     listing = _cli("reproduce", cwd=tmp_path)
     assert "toy: the toy experiment" in listing.stdout and "basso2012" in listing.stdout
 

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import resource
 import time
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated
 
@@ -19,6 +21,38 @@ from rgbd_eval.cli.common import (
 from rgbd_eval.errors import OutputError
 from rgbd_eval.outdir import OutputFolder
 from rgbd_eval.verdicts import tally
+
+
+def cpu_seconds() -> float:
+    """CPU seconds of this process and of its ended children (a local cluster's workers).
+
+    Children count once they have ended: a local cluster's workers when it shuts down.
+    """
+    own = resource.getrusage(resource.RUSAGE_SELF)
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
+
+
+def cpu_summary(generate_s: float, experiments_s: float, data: dict[str, object]) -> str:
+    """One line on where the CPU went: generating recordings, rendering inside, the method.
+
+    A paper's experiments that render scenes themselves (per seed or per camera layout)
+    report that share as ``data["cpu_s"]["render"]``.
+    """
+    inner = data.get("cpu_s")
+    render_inside = float(inner.get("render", 0.0)) if isinstance(inner, dict) else 0.0
+    render = generate_s + render_inside
+    method = max(0.0, experiments_s - render_inside)
+    return (
+        f"CPU time: {generate_s + experiments_s:.0f} s, of which rendering {render:.0f} s and "
+        f"the experiments {method:.0f} s (all processes, this machine: {_machine()})"
+    )
+
+
+def _machine() -> str:
+    from rgbd_eval.machine import machine_info
+
+    return machine_info()["cpu"] or "unknown CPU"
 
 
 @handle_errors
@@ -66,19 +100,34 @@ def reproduce(
     names = ["reproduce.md", "reproduce.html"]
     # The output folder is checked and staged before the scenarios are generated and run.
     with OutputFolder(out_dir, "reproduce.json", force, command="reproduce", names=names) as folder:
+        cpu_start = cpu_seconds()
         recordings = {
             Path(name).stem: ensure_scenario(name, data, lambda m: err_console.print(m))
             for name in spec.scenarios
         }
+        cpu_generated = cpu_seconds()
         with connect(cluster_spec, warm_up=warm_up) as client:
             options = ReproduceOptions(
                 client=client, cache=cache, progress=lambda m: err_console.print(m)
             )
             result = spec.experiments()(recordings, options)
+        # After the cluster's shutdown, so that its workers' CPU is counted (a remote
+        # cluster's is not: the figure is then this process's only).
+        generate_s, experiments_s = cpu_generated - cpu_start, cpu_seconds() - cpu_generated
+        payload = {
+            "method": system,
+            **result.data,
+            "cpu_total_s": {
+                "generate": round(generate_s, 1),
+                "experiments": round(experiments_s, 1),
+            },
+        }
+        line = cpu_summary(generate_s, experiments_s, dict(result.data))
+        result = replace(result, markdown=f"{result.markdown.rstrip()}\n\n{line}\n")
         staging = folder.staging
         write_text(staging / "reproduce.md", result.markdown)
-        write_json(staging / "reproduce.json", {"method": system, **result.data})
-        write_text(staging / "reproduce.html", reproduce_page(result, system))
+        write_json(staging / "reproduce.json", payload)
+        write_text(staging / "reproduce.html", reproduce_page(result, system, cpu_line=line))
         folder.commit()
     console.print(result.markdown, markup=False)
     if result.claims:

@@ -302,6 +302,9 @@ def summarise(paper: Mapping[str, Any], runs: Mapping[int, RunJudgement]) -> Rep
     }
     data: dict[str, Any] = {
         "seeds": seeds,
+        # The closed-loop runs render their frames: that share of the CPU, for the page's
+        # split into rendering and method (rgbd_eval.cli.reproduce_cmd.cpu_summary).
+        "cpu_s": {"render": sum(runs[s].result.cpu_s.get("render", 0.0) for s in seeds)},
         "fig8": {
             str(s): {
                 "people": [

@@ -441,14 +441,17 @@ def _claims(result: ReproduceResult) -> list[ClaimRow]:
 
 
 def reproduce_page(
-    result: ReproduceResult, method: str, paper: Mapping[str, Any] | None = None
+    result: ReproduceResult,
+    method: str,
+    paper: Mapping[str, Any] | None = None,
+    cpu_line: str = "",
 ) -> str:
     """``reproduce.html``: per table the paper's value beside ours, the claims, the figures redrawn.
 
     Reads the result's JSON data: ``tables`` (table -> row -> measured summary) beside
     the paper's tables of the same keys (``paper``, by default the method's ``paper.yaml``);
     ``track_lengths`` and ``voxel_timing_ms`` where the paper has those figures (basso2012's
-    Figures 7.7 and 7.9).
+    Figures 7.7 and 7.9). ``cpu_line`` says where the CPU time went (rendering, method).
     """
     paper = paper if paper is not None else (paper_file(method) or {})
     data = result.data
@@ -495,6 +498,7 @@ def reproduce_page(
         method=method,
         source=paper.get("source", ""),
         seconds=float(data.get("seconds", 0.0)),
+        cpu_line=cpu_line,
         tables=tables,
         figures=figures,
         claims=_claims(result),
