@@ -503,30 +503,23 @@ def check_claims(
                 largest_gap_points=100 * max((abs(d) for d in diffs.values()), default=0.0),
             )
         )
-        spec = _spec(claims, "main_tr_overall")
-        main = [float(row.get("main_tr") or 0.0) for row in measured.values()]
-        mean_main = sum(main) / len(main)
-        out.append(
-            _claim(
-                spec,
-                mean_main >= _num(spec, "min_main_tr"),
-                f"Main Tr. {100 * mean_main:.1f}% (mean of {len(main)} sequences; "
-                f"thesis {100 * _num(spec, 'paper'):.0f}%)",
-                main_tr_pct=100 * mean_main,
+        # 7.3's text: the six rows' mean Main Tr. and All Tr. (the thesis' 78.1% and 95.7%)
+        for key, col, label, least in (
+            ("main_tr_overall", "main_tr", "Main Tr.", "min_main_tr"),
+            ("all_tr_overall", "all_tr", "All Tr.", "min_all_tr"),
+        ):
+            spec = _spec(claims, key)
+            values = [float(row.get(col) or 0.0) for row in measured.values()]
+            mean = sum(values) / len(values)
+            out.append(
+                _claim(
+                    spec,
+                    mean >= _num(spec, least),
+                    f"{label} {100 * mean:.1f}% (mean of {len(values)} sequences; "
+                    f"thesis {100 * _num(spec, 'paper'):.0f}%)",
+                    **{f"{col}_pct": 100 * mean},
+                )
             )
-        )
-        spec = _spec(claims, "all_tr_overall")
-        every = [float(row.get("all_tr") or 0.0) for row in measured.values()]
-        mean_all = sum(every) / len(every)
-        out.append(
-            _claim(
-                spec,
-                mean_all >= _num(spec, "min_all_tr"),
-                f"All Tr. {100 * mean_all:.1f}% (mean of {len(every)} sequences; "
-                f"thesis {100 * _num(spec, 'paper'):.0f}%)",
-                all_tr_pct=100 * mean_all,
-            )
-        )
         spec = _spec(claims, "motp_around_80")
         lo, hi = _num(spec, "low"), _num(spec, "high")
         motp = {s: row.get("motp") for s, row in measured.items()}
