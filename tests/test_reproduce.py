@@ -237,7 +237,9 @@ def test_reproduce_judges_every_claim_over_the_paper_seeds(
     # recordings and a run with the thesis' config; each claim's verdict is over the seeds.
     seen: dict[int, tuple[dict[str, Path], dict[str, object]]] = {}
 
-    def recordings(recs: object, seeds: list[int], progress: object) -> dict[int, dict[str, Path]]:
+    def recordings(
+        recs: object, seeds: list[int], progress: object, client: object
+    ) -> dict[int, dict[str, Path]]:
         return {s: {"moving_complex": tmp_path / f"moving_complex-seed{s}.mcap"} for s in seeds}
 
     def run(
@@ -283,6 +285,26 @@ def test_seeded_recordings_reuse_the_scenarios_own_seed(
     assert made == [("static_simple-seed2.mcap", 2)]
     seeded_recordings({"static_simple": own}, [1, 2])  # present: not rendered again
     assert len(made) == 1
+
+
+def test_seeded_recordings_render_on_the_cluster(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # With a client the missing recordings are rendered as tasks (on 2 cores: two at once).
+    from rgbd_eval.engine import connect, parse_cluster
+
+    def fake(scenario: Path, target: Path, seed: int) -> None:
+        target.write_bytes(str(seed).encode())
+        target.with_name(f"{target.stem}.gt.csv").write_text("")
+
+    monkeypatch.setattr(experiments, "render_seeded", fake)
+    own = tmp_path / "moving_obstacles.mcap"  # moving_obstacles.yaml has seed 6
+    with connect(parse_cluster("local:1")) as client:
+        got = seeded_recordings({"moving_obstacles": own}, [2, 3], client=client)
+    assert [p.read_bytes() for p in (got[2]["moving_obstacles"], got[3]["moving_obstacles"])] == [
+        b"2",
+        b"3",
+    ]
 
 
 def test_claims_render_with_their_sentences() -> None:

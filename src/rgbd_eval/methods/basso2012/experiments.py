@@ -27,6 +27,7 @@ from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig, build_config, load_config, load_paper
 from rgbd_eval.datasets import scenarios_dir
+from rgbd_eval.engine import map_ordered
 from rgbd_eval.errors import ConfigError, InputError, TaskError
 from rgbd_eval.files import file_digest
 from rgbd_eval.machine import machine_info
@@ -115,9 +116,13 @@ def paper_seeds(paper: Mapping[str, Any] | None = None) -> list[int]:
 
 
 def seeded_recordings(
-    recordings: Mapping[str, Path], seeds: Sequence[int], progress: Progress | None = None
+    recordings: Mapping[str, Path],
+    seeds: Sequence[int],
+    progress: Progress | None = None,
+    client: Client | None = None,
 ) -> dict[int, dict[str, Path]]:
-    """Per seed, each scenario's recording rendered with that seed (generated when absent).
+    """Per seed, each scenario's recording rendered with that seed (generated when absent,
+    on ``client``'s workers when given).
 
     ``recordings`` are the scenarios' own (their YAML's ``seed``), named as in
     ``configs/scenarios``; at that seed the recording is reused (same scenario and seed give
@@ -125,19 +130,31 @@ def seeded_recordings(
     """
     say = progress or (lambda _msg: None)
     out: dict[int, dict[str, Path]] = {}
+    missing: list[tuple[Path, Path, int]] = []
     for seed in seeds:
         out[seed] = {}
         for name, path in recordings.items():
-            scenario = load_scenario(scenarios_dir() / f"{name}.yaml")
-            if scenario.seed == seed:
+            source = scenarios_dir() / f"{name}.yaml"
+            if load_scenario(source).seed == seed:
                 out[seed][name] = path
                 continue
             target = path.with_name(f"{sequence_name(path)}-seed{seed}.mcap")
             if not target.exists() or sidecar_path(target) is None:
-                say(f"generating {target} (scenario seed {seed}) ...")
-                synthesize(scenario, target, "mcap", seed=seed)
+                missing.append((source, target, seed))
             out[seed][name] = target
+    if missing:
+        say(f"generating {len(missing)} recordings at the other scenario seeds ...")
+        if client is None:
+            for args in missing:
+                render_seeded(*args)
+        else:
+            map_ordered(client, render_seeded, missing)
     return out
+
+
+def render_seeded(scenario: Path, target: Path, seed: int) -> None:
+    """``synth`` of the scenario file at ``seed`` to ``target`` (a task of :func:`seeded_recordings`)."""
+    synthesize(load_scenario(scenario), target, "mcap", seed=seed)
 
 
 @dataclass(frozen=True)
@@ -1137,7 +1154,7 @@ def reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> Repr
     """``rgbd-eval reproduce basso2012``: the tables, figures and claims of chapter 7, over
     ``paper.yaml``'s scenario seeds (their recordings generated beside ``recordings``)."""
     paper = paper_values()
-    by_seed = seeded_recordings(recordings, paper_seeds(paper), options.progress)
+    by_seed = seeded_recordings(recordings, paper_seeds(paper), options.progress, options.client)
     res = reproduce_seeds(
         by_seed,
         client=options.client,
