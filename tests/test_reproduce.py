@@ -6,20 +6,32 @@ from pathlib import Path
 
 import pytest
 
+import rgbd_eval.methods.basso2012.experiments as experiments
+from rgbd_eval.config import load_config
 from rgbd_eval.datasets import scenarios_dir
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.methods.basso2012.experiments import (
     THRESHOLDS,
     VOXEL_SIZES,
     Reproduction,
+    SeededReproduction,
     check_claims,
     miss_counts,
+    paper_seeds,
     paper_values,
     render_markdown,
+    render_seeds_markdown,
     reproduce_basso2012,
+    seeded_recordings,
+    seeds_json,
+    thesis_base,
+    verdicts,
 )
+from rgbd_eval.plugins import ReproduceResult
+from rgbd_eval.report.html.pages import reproduce_page
 from rgbd_eval.sim import load_scenario, synthesize
 from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
+from rgbd_eval.verdicts import Verdict
 
 
 def row(
@@ -84,7 +96,7 @@ def judged(res: Reproduction) -> dict[str, bool]:
 
 def test_every_claim_holds_on_thesis_like_numbers() -> None:
     held = judged(thesis_like())
-    assert len(held) == len(paper_values()["claims"]) == 11
+    assert len(held) == len(paper_values()["claims"]) == 12
     assert all(held.values()), held
 
 
@@ -92,6 +104,10 @@ def _break(name: str, res: Reproduction) -> None:
     """Change ``res`` so that the claim ``name`` (and only it) should fail."""
     if name == "mota_per_sequence":  # 89.6% - 6 points: 6 > 5 points from the thesis
         res.tables["7.2"]["static_obstacles"]["mota"] = 0.836
+    elif name == "main_tr_overall":  # static_simple 76.7% -> 70%: the six rows' mean 77.0% < 77.5%
+        res.tables["7.2"]["static_simple"]["main_tr"] = 0.70
+    elif name == "all_tr_overall":  # static_obstacles 92.5% -> 90%: the mean 95.3% < 95.5%
+        res.tables["7.2"]["static_obstacles"]["all_tr"] = 0.90
     elif name == "motp_around_80":  # 70% is not 'around 80%' (below 75%)
         res.tables["7.3"]["moving_simple"]["motp"] = 0.70
     elif name == "table_7_4_drop":  # 89.1 - 79.1 = 10 points: no 'about 50' drop
@@ -108,8 +124,6 @@ def _break(name: str, res: Reproduction) -> None:
         res.tables["7.6"]["-2.0"]["fp_rate"] = 0.01
     elif name == "figure_7_7_memory":  # 9 tracks at 3 s against 10 at 0 s: 0.9 > 0.8
         res.track_lengths["moving_complex"][3.0] = [50] * 9
-    elif name == "figure_7_9_total":  # 31.7 ms + 2 ms at 0.04 m: over 33 ms
-        res.voxel_timing[VOXEL_SIZES[0]]["total_detect"] = 33.5
     elif name == "figure_7_9_clustering":  # voxel grid 2 -> 8 ms: range 6 > 0.5 x clustering's 6
         for i, v in enumerate(VOXEL_SIZES):
             res.voxel_timing[v]["voxel"] = 8.0 - 1.2 * i
@@ -124,6 +138,173 @@ def test_every_claim_can_fail(name: str) -> None:
     sentence = paper_values()["claims"][name]["sentence"]
     failed = [s for s, held in judged(res).items() if not held]
     assert failed == [sentence]
+
+
+def test_figure_7_9_time_is_a_measurement_not_a_claim() -> None:
+    # 7.2's 25-29 ms under 33 ms was measured in C++ on an i5-520M: shown beside ours with
+    # the hardware, never held or failed on another machine's Python.
+    res = thesis_like()
+    res.voxel_timing[VOXEL_SIZES[0]]["total_detect"] = 80.0
+    assert all(judged(res).values())
+    assert "0.025 seconds" not in " ".join(judged(res))
+    timing = paper_values()["timing"]
+    assert timing["detect_ms"] == [25.0, 29.0] and timing["budget_ms"] == 33.0
+    assert "i5-520M" in timing["hardware"]
+
+
+def test_reproduce_runs_the_thesis_configuration() -> None:
+    # 5.2: plain Euclidean clusters; 5.3: the centroid is the points' mean; 5.4.1: the floor
+    # is known (clicked), not fitted; 5.4.2: cut windows unscored. `run` keeps our additions.
+    det = thesis_base()["detector"]
+    assert det["subclustering"] is False
+    assert det["surface_correction"] is False
+    assert det["ground_mode"] == "world"
+    assert det["hog_border"] == "skip"
+    default = load_config(method="basso2012").detector.model_dump(mode="json")
+    assert default["subclustering"] is True and default["surface_correction"] is True
+    assert default["ground_mode"] == "auto" and default["hog_border"] == "pad"
+    assert paper_seeds() == [1, 2, 3, 4, 5]
+
+
+def _seeded(*broken: tuple[int, str]) -> SeededReproduction:
+    """Thesis-like runs on seeds 1, 2, 3; ``broken``: (seed, claim) pairs made to fail."""
+    runs = {}
+    for seed in (1, 2, 3):
+        res = thesis_like()
+        for s, name in broken:
+            if s == seed:
+                _break(name, res)
+        res.claims = check_claims(res, paper_values()["claims"])
+        runs[seed] = res
+    return SeededReproduction(runs, verdicts(runs), 12.0)
+
+
+def test_a_claim_that_flips_between_seeds_is_inconclusive() -> None:
+    claims = paper_values()["claims"]
+    res = _seeded((2, "table_7_5_mota"), *((s, "main_tr_overall") for s in (1, 2, 3)))
+    by = {v.sentence: v for v in res.verdicts}
+    flipping = by[claims["table_7_5_mota"]["sentence"]]
+    assert flipping.verdict is Verdict.INCONCLUSIVE
+    assert [c.held for c in flipping.per_seed.values()] == [True, False, True]
+    gain = flipping.spreads["gain_points"]  # 16.3 on seeds 1 and 3, 2.0 on seed 2
+    assert (gain.low, gain.high, gain.runs) == (pytest.approx(2.0), pytest.approx(16.3), 3)
+    assert by[claims["main_tr_overall"]["sentence"]].verdict is Verdict.FAILED
+    held = [
+        v
+        for k, v in by.items()
+        if k not in {flipping.sentence, claims["main_tr_overall"]["sentence"]}
+    ]
+    assert len(held) == 10 and all(v.verdict is Verdict.HELD for v in held)
+
+
+def test_seeds_page_and_json_show_verdicts_spreads_statements_and_time() -> None:
+    paper = paper_values()
+    res = _seeded((3, "all_tr_overall"))
+    text = render_seeds_markdown(res, paper)
+    assert (
+        "over 3 scenario seeds" in text and "**11 held, 0 failed, 1 inconclusive of 12.**" in text
+    )
+    assert "`detector.subclustering: false`" in text and "`detector.ground_mode: world`" in text
+    # The published statements without a table row: paper value, ours, verdict.
+    assert (
+        '"We track 78% of every ground truth track with a single ID." | 78% | '
+        "78.1% [78.1, 78.1] over 3 runs | **held** |" in text
+    )
+    all_tr = next(
+        line for line in text.splitlines() if "raises to 96%" in line and "| 96% |" in line
+    )
+    assert "[95.3, 95.7] over 3 runs" in all_tr and "**inconclusive**" in all_tr
+    assert "detection time, a measurement beside the thesis' (not a claim)" in text
+    assert "Intel i5-520M" in text and "## Scenario seed 3" in text
+    data = seeds_json(res, paper)
+    assert data["seeds"] == [1, 2, 3]
+    (claim,) = (c for c in data["claims"] if "raises to 96%" in c["text"])
+    assert claim["verdict"] == "inconclusive"
+    assert claim["per_seed"] == {"1": True, "2": True, "3": False}
+    assert claim["measured"]["all_tr_pct"]["min"] == pytest.approx(95.3, abs=0.05)
+    assert data["tables"]["7.2"]["static_simple"]["mota"] == pytest.approx(0.931)
+    assert data["tables_spread"]["7.2"]["static_obstacles"]["all_tr"]["min"] == pytest.approx(0.90)
+    assert data["detection_time"]["paper_detect_ms"] == [25.0, 29.0]
+    result = ReproduceResult(text, data, tuple((v.sentence, v.verdict) for v in res.verdicts))
+    page = reproduce_page(result, "basso2012")
+    assert "inconclusive" in page and "Table 7.2" in page
+
+
+def test_reproduce_judges_every_claim_over_the_paper_seeds(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The entry point of `rgbd-eval reproduce basso2012`: every seed of paper.yaml gets its
+    # recordings and a run with the thesis' config; each claim's verdict is over the seeds.
+    seen: dict[int, tuple[dict[str, Path], dict[str, object]]] = {}
+
+    def recordings(
+        recs: object, seeds: list[int], progress: object, client: object
+    ) -> dict[int, dict[str, Path]]:
+        return {s: {"moving_complex": tmp_path / f"moving_complex-seed{s}.mcap"} for s in seeds}
+
+    def run(
+        recs: dict[str, Path], client: object, cache: object, say: object, base: dict[str, object]
+    ) -> Reproduction:
+        seed = int(next(iter(recs.values())).stem.rsplit("seed", 1)[1])
+        seen[seed] = (recs, base)
+        res = thesis_like()
+        if seed == 4:
+            _break("table_7_6_high_threshold", res)
+        res.claims = check_claims(res, paper_values()["claims"])
+        return res
+
+    monkeypatch.setattr(experiments, "seeded_recordings", recordings)
+    monkeypatch.setattr(experiments, "reproduce_basso2012", run)
+    result = experiments.reproduce({}, experiments.ReproduceOptions())
+    assert sorted(seen) == [1, 2, 3, 4, 5]
+    assert all(base["detector"]["subclustering"] is False for _, base in seen.values())  # type: ignore[index]
+    verdict = dict(result.verdicts())
+    high = paper_values()["claims"]["table_7_6_high_threshold"]["sentence"]
+    assert verdict.pop(high) is Verdict.INCONCLUSIVE
+    assert set(verdict.values()) == {Verdict.HELD} and len(verdict) == 11
+    assert result.data["seeds"] == [1, 2, 3, 4, 5]
+
+
+def test_seeded_recordings_reuse_the_scenarios_own_seed(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    made: list[tuple[str, int | None]] = []
+
+    def fake(scenario: object, out: Path, container: str, seed: int | None = None) -> None:
+        made.append((Path(out).name, seed))
+        Path(out).write_bytes(b"")
+        Path(out).with_name(f"{Path(out).stem}.gt.csv").write_text("")
+
+    monkeypatch.setattr(experiments, "synthesize", fake)
+    own = tmp_path / "static_simple.mcap"  # static_simple.yaml has seed 1
+    got = seeded_recordings({"static_simple": own}, [1, 2])
+    assert got == {
+        1: {"static_simple": own},
+        2: {"static_simple": tmp_path / "static_simple-seed2.mcap"},
+    }
+    assert made == [("static_simple-seed2.mcap", 2)]
+    seeded_recordings({"static_simple": own}, [1, 2])  # present: not rendered again
+    assert len(made) == 1
+
+
+def test_seeded_recordings_render_on_the_cluster(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # With a client the missing recordings are rendered as tasks (on 2 cores: two at once).
+    from rgbd_eval.engine import connect, parse_cluster
+
+    def fake(scenario: Path, target: Path, seed: int) -> None:
+        target.write_bytes(str(seed).encode())
+        target.with_name(f"{target.stem}.gt.csv").write_text("")
+
+    monkeypatch.setattr(experiments, "render_seeded", fake)
+    own = tmp_path / "moving_obstacles.mcap"  # moving_obstacles.yaml has seed 6
+    with connect(parse_cluster("local:1")) as client:
+        got = seeded_recordings({"moving_obstacles": own}, [2, 3], client=client)
+    assert [p.read_bytes() for p in (got[2]["moving_obstacles"], got[3]["moving_obstacles"])] == [
+        b"2",
+        b"3",
+    ]
 
 
 def test_claims_render_with_their_sentences() -> None:

@@ -328,6 +328,31 @@ def test_ground_initialisation_modes(mode: str) -> None:
     np.testing.assert_allclose(det.ground_plane, [0.0, -1.0, 0.0, 1.0], atol=0.01)
 
 
+def test_world_mode_takes_the_floor_from_the_camera_pose() -> None:
+    # The thesis' floor is known (three clicked points, 5.4.1); 'world' knows it from the
+    # pose: camera 1.1 m above the world's z = 0, pitched 10 degrees down. The first plane is
+    # that floor exactly (no fit), so a floor with a raised platform in view cannot tilt it.
+    person = Person(3.5, 0.2, 1.75)
+    pose = camera_pose(height=1.1, pitch_deg=10)
+    frame = render(Scene(people=[person]), pose)
+    det = Basso2012Detector(DetectorConfig(ground_mode=GroundMode.WORLD))
+    first = det.ground.initialise(np.zeros((0, 3)), pose, np.zeros((0, 2)), np.zeros((0, 3)), 1.0)
+    assert first is not None
+    up = pose.rotation_matrix() @ first[:3]
+    np.testing.assert_allclose(up, [0.0, 0.0, 1.0], atol=1e-9)
+    assert first[3] == pytest.approx(1.1)
+    dets = det.detect(frame)
+    assert len(dets) == 1
+    _assert_person(dets[0], person)
+
+
+def test_world_mode_without_odometry_is_a_config_error() -> None:
+    frame = render(Scene(people=[Person(3.5, 0.0)]), camera_pose(height=1.0))
+    frame = dataclasses.replace(frame, camera_pose=OPTICAL_TO_BODY, has_odometry=False)
+    with pytest.raises(ConfigError, match="ground_mode 'world' needs the camera's pose"):
+        Basso2012Detector(DetectorConfig(ground_mode=GroundMode.WORLD)).detect(frame)
+
+
 def test_points_mode_without_points_is_a_config_error() -> None:
     with pytest.raises(ValueError, match="ground_points"):
         DetectorConfig(ground_mode=GroundMode.POINTS)

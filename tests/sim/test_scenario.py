@@ -46,6 +46,24 @@ def test_shipped_scenarios_load_and_match_the_thesis_test_set() -> None:
     assert not demo.robot.path
 
 
+def test_thesis_scenes_are_a_lab_with_walking_people_only() -> None:
+    # Issue 31: the thesis' sequences were recorded in a lab (7.1) with people walking; the
+    # seated people and the person-sized clutter (coat stands, plants, cabinets, mannequins)
+    # are ours, in the *_clutter scenes only.
+    clutter_kinds = {"coat_stand", "plant", "cabinet", "mannequin"}
+    lab = {"table", "chair", "shelf", "door"}
+    for name in THESIS:
+        sc = load_scenario(scenarios_dir() / f"{name}.yaml")
+        kinds = {o.kind.value for o in sc.obstacles}
+        assert lab <= kinds, name
+        assert not kinds & (clutter_kinds | {"sofa"}), name
+        assert all(w.sit_s == 0.0 for p in sc.people for w in p.path), name
+    for name in ("static_clutter", "moving_clutter"):
+        sc = load_scenario(scenarios_dir() / f"{name}.yaml")
+        assert clutter_kinds <= {o.kind.value for o in sc.obstacles}, name
+        assert any(w.sit_s > 0.0 for p in sc.people for w in p.path), name
+
+
 def test_kinect_defaults() -> None:
     sc = parse_scenario({"name": "x", "duration_s": 1.0})
     # seed 000, 2.1: 640x480, 57 x 43 degrees

@@ -1,6 +1,7 @@
 """The ground plane across frames (seed 000, 5.1, 5.4.1, 5.4.2).
 
-The plane is initialised once (three floor points or pixels, a given plane, or
+The plane is initialised once (three floor points or pixels, a given plane, the
+world frame's floor z = 0 seen from the first frame's camera pose, or
 automatically by RANSAC over the lower part of the cloud, keeping the plane
 whose normal agrees with gravity), then refined every frame by a least-squares
 fit to the points within one voxel of it, and kept unchanged when too few floor
@@ -43,6 +44,10 @@ class GroundMode(enum.Enum):
     AUTO = "auto"
     POINTS = "points"
     PLANE = "plane"
+    #: The world frame's z = 0 (the floor of the recording's odometry or map frame), put in
+    #: the camera frame by the first frame's camera pose: the floor is known, as the thesis'
+    #: three clicked floor points make it known (5.4.1), without a person to click.
+    WORLD = "world"
 
 
 class GroundSettings(Protocol):
@@ -68,6 +73,12 @@ def gravity_up_in_optical(camera_pose: Pose) -> FloatArray:
     """World +z (up) expressed in the depth optical frame."""
     up: FloatArray = camera_pose.rotation_matrix().T @ np.array([0.0, 0.0, 1.0])
     return up
+
+
+def floor_from_pose(camera_pose: Pose) -> FloatArray:
+    """The world's z = 0 plane in the depth optical frame of ``camera_pose`` (normal up)."""
+    up = gravity_up_in_optical(camera_pose)
+    return normalise_plane((*up, float(camera_pose.translation[2])))
 
 
 def auto_ground_plane(
@@ -190,6 +201,8 @@ class GroundPlaneEstimator:
             if pts is None:
                 return None
             return plane_from_points(pts[0], pts[1], pts[2])
+        if cfg.ground_mode is GroundMode.WORLD:
+            return floor_from_pose(camera_pose)
         up = gravity_up_in_optical(camera_pose)
         return auto_ground_plane(
             voxel_points, up, cfg.voxel_size, math.radians(cfg.ground_max_tilt_deg)

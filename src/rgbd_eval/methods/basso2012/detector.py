@@ -198,6 +198,11 @@ class Basso2012Detector:
     def _ground_plane(self, frame: Frame, cloud: PointCloud, grid: VoxelGrid) -> FloatArray | None:
         if self.ground.plane is None:
             _check_ground_pixels(self.config, frame.rgb_camera)
+            if self.config.ground_mode is GroundMode.WORLD and not frame.has_odometry:
+                raise ConfigError(
+                    "detector.ground_mode 'world' needs the camera's pose in a world frame "
+                    "whose z = 0 is the floor (odometry or tf); this recording has none"
+                )
             uv, _ = project_to_rgb(cloud.points, frame.depth_to_rgb, frame.rgb_camera)
             plane = self.ground.initialise(
                 grid.centroids,

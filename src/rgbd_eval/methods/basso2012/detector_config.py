@@ -50,7 +50,12 @@ class Basso2012DetectorConfig(ComponentConfig):
     cluster_tolerance_voxels: float = Field(
         2.0, gt=0.0, description="Euclidean clustering tolerance in voxels (5.4.2: 2 x voxel)"
     )
-    ground_mode: GroundMode = Field(GroundMode.AUTO, description="initial ground plane source")
+    ground_mode: GroundMode = Field(
+        GroundMode.AUTO,
+        description="initial ground plane source: 'auto' (RANSAC, gravity from odometry), "
+        "'points' (three floor points or pixels, 5.4.1), 'plane' (given), 'world' (the world "
+        "frame's z = 0 seen from the first camera pose; `reproduce basso2012` uses it)",
+    )
     ground_points: list[tuple[float, float, float]] | None = Field(
         None, description="three floor points (x, y, z) in the depth optical frame, mode 'points'"
     )
