@@ -1019,8 +1019,8 @@ def render_seeds_markdown(res: SeededReproduction, paper: Mapping[str, Any]) -> 
         f"# Reproduction of basso2012 (seed 000, chapter 7) over {len(seeds)} scenario seeds",
         "",
         f"Scenario seeds {', '.join(map(str, seeds))}: each draws other people (bodies, clothes, "
-        "hair) and other sensor noise for every sequence; the paths and heights are the "
-        f"scenes'. Wall time {res.seconds:.0f} s. Sequences are synthetic stand-ins "
+        "hair), other paths (rgbd_eval.sim.variation) and other sensor noise for every "
+        f"sequence; the heights are the scenes'. Wall time {res.seconds:.0f} s. Sequences are synthetic stand-ins "
         "(configs/scenarios/); the thesis' recordings are not available. The method as the "
         f"thesis describes it (paper.yaml `thesis_config`: {_overrides(paper)}) with the "
         "authors' classifier (`detector.hog: authors`). A claim is held when it holds on "
