@@ -72,7 +72,10 @@ def reproduce(
         }
         with connect(cluster_spec, warm_up=warm_up) as client:
             options = ReproduceOptions(
-                client=client, cache=cache, progress=lambda m: err_console.print(m)
+                client=client,
+                cache=cache,
+                progress=lambda m: err_console.print(m),
+                data=data,
             )
             result = spec.experiments()(recordings, options)
         staging = folder.staging
