@@ -317,7 +317,7 @@ def cbrt(x: X) -> X:
         r = power(a, 1.0 / 3.0)
         if 0.0 < r < math.inf:
             r = r - (r * r * r - a) / (3.0 * (r * r))
-        return (-r if xs < 0 else r)  # type: ignore[return-value]
+        return -r if xs < 0 else r  # type: ignore[return-value]
     xa = _array(x)
     aa: F64 = np.abs(xa)
     ra: F64 = power(aa, 1.0 / 3.0)
