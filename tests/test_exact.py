@@ -49,6 +49,13 @@ def test_atan2_quadrants_and_axes() -> None:
         assert exact.atan2(yy, xx) == pytest.approx(math.atan2(yy, xx), abs=1e-15)
 
 
+def test_cube_root_within_a_few_ulp_and_odd() -> None:
+    x = RNG.uniform(-1e6, 1e6, 100_000)
+    assert _ulps(exact.cbrt(x), np.cbrt(x)) <= 4
+    assert exact.cbrt(-8.0) == pytest.approx(-2.0, rel=1e-15) and exact.cbrt(0.0) == 0.0
+    assert exact.cbrt(-27.0) == float(exact.cbrt(np.array([-27.0]))[0])
+
+
 def test_special_values() -> None:
     assert exact.exp(-800.0) == 0.0 and exact.exp(800.0) == math.inf
     assert exact.log(0.0) == -math.inf and math.isnan(exact.log(-1.0))

@@ -309,6 +309,25 @@ def power(x: X, y: float) -> X:
     return out  # type: ignore[return-value]
 
 
+def cbrt(x: X) -> X:
+    """The real cube root (negative for negative x): power(|x|, 1/3), one Newton step, sign."""
+    if _is_scalar(x):
+        xs = float(x)
+        a = abs(xs)
+        r = power(a, 1.0 / 3.0)
+        if 0.0 < r < math.inf:
+            r = r - (r * r * r - a) / (3.0 * (r * r))
+        return -r if xs < 0 else r  # type: ignore[return-value]
+    xa = _array(x)
+    aa: F64 = np.abs(xa)
+    ra: F64 = power(aa, 1.0 / 3.0)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        step = ra - (ra * ra * ra - aa) / (3.0 * (ra * ra))
+    ra = np.where((ra > 0.0) & np.isfinite(ra), step, ra)
+    out: F64 = np.where(xa < 0, -ra, ra)
+    return out  # type: ignore[return-value]
+
+
 def hypot(x: X, y: X) -> X:
     """sqrt(x^2 + y^2) (no care for overflow: the simulator's lengths are metres)."""
     if _is_scalar(x) and _is_scalar(y):

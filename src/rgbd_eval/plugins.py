@@ -185,6 +185,9 @@ class ReproduceOptions:
     client: Client | None = None
     cache: Path | None = None
     progress: Callable[[str], None] = field(default=lambda _m: None)
+    #: The folder of generated recordings (``--data``; None: the datasets folder), for
+    #: experiments that render their own (per scenario seed).
+    data: Path | None = None
 
 
 @dataclass(frozen=True)

@@ -215,3 +215,17 @@ def test_the_lint_finds_what_it_forbids(tmp_path: Path) -> None:
     finally:
         bad.unlink()
     assert len(found) == 6, found
+
+
+def test_the_occlusion_classifiers_training_calls_nothing_whose_bits_depend_on_the_cpu() -> None:
+    # cielniak2010's shipped model is retrained from rendered tuning scenes: its features
+    # (colour moments, outline gradients) and the boosting must give the same bytes
+    # everywhere, as the renderer does (issue 31)
+    files = [
+        SRC / "methods" / "cielniak2010" / "occlusion.py",
+        SRC / "methods" / "cielniak2010" / "occlusion_training.py",
+        SRC / "track" / "adaboost.py",
+        SRC / "track" / "colour_moments.py",
+    ]
+    bad = [v for f in files for v in _violations(f)]
+    assert bad == [], "use rgbd_eval.exact instead:\n" + "\n".join(bad)

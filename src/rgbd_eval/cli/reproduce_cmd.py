@@ -108,7 +108,10 @@ def reproduce(
         cpu_generated = cpu_seconds()
         with connect(cluster_spec, warm_up=warm_up) as client:
             options = ReproduceOptions(
-                client=client, cache=cache, progress=lambda m: err_console.print(m)
+                client=client,
+                cache=cache,
+                progress=lambda m: err_console.print(m),
+                data=data,
             )
             result = spec.experiments()(recordings, options)
         # After the cluster's shutdown, so that its workers' CPU is counted (a remote

@@ -141,45 +141,113 @@ def render_pair(
         scenario = pair_scenario(rng, illumination)
         index = int(rng.integers(0, 12))
         sim = Simulator(scenario)
-        cfg = scenario.rig[0]
-        if not isinstance(cfg, ThermalCameraConfig):  # pragma: no cover - built above
-            raise TypeError("the pair scenario's rig must be a thermal camera")
-        camera = ThermalCamera(cfg, "world")
-        view = sim.scene_view(index, 0)
-        pose = camera.pose(view)
-        meshes = sim.people_meshes(sim.time(index))
-        extents = [projected_extent(m.vertices, camera.camera, pose) for _, m, _, _ in meshes]
-        if len(extents) != 2 or extents[0] is None or extents[1] is None:
+        pairs = _frame_pairs(sim, index, rng, jitter)
+        if pairs:
+            return pairs[0]
+    raise ValueError(f"no overlapping pair in {_MAX_TRIES} draws")
+
+
+def _thermal_camera(scenario: Scenario) -> tuple[int, ThermalCamera]:
+    """The rig index and camera of the scenario's first thermal camera (ValueError: none)."""
+    for k, cfg in enumerate(scenario.rig):
+        if isinstance(cfg, ThermalCameraConfig):
+            return k, ThermalCamera(cfg, "world")
+    raise ValueError(f"scenario {scenario.name!r} has no thermal camera")
+
+
+def _frame_pairs(
+    sim: Simulator, index: int, rng: np.random.Generator, jitter: float
+) -> list[RenderedPair]:
+    """Every pair of people in frame ``index`` whose thermal boxes (cut to the image)
+    overlap by :data:`MIN_OVERLAP`, rendered (nothing is rendered when none does).
+
+    The pairs are in the order of the people in the scenario (``(i, j)``, ``i < j``);
+    the jitter of each pair's boxes is drawn from ``rng`` in that order.
+    """
+    stream, camera = _thermal_camera(sim.scenario)
+    view = sim.scene_view(index, stream)
+    pose = camera.pose(view)
+    meshes = sim.people_meshes(sim.time(index))
+    size = (float(camera.camera.width), float(camera.camera.height))
+    boxes: list[Box | None] = []
+    for _, mesh, _, _ in meshes:
+        extent = projected_extent(mesh.vertices, camera.camera, pose)
+        boxes.append(None if extent is None else _clipped(extent, size))
+    found = [
+        (i, j)
+        for i in range(len(meshes))
+        for j in range(i + 1, len(meshes))
+        if (a := boxes[i]) is not None
+        and (b := boxes[j]) is not None
+        and _overlap(a, b) >= MIN_OVERLAP
+    ]
+    if not found:
+        return []
+    frame = sim.frame(index)
+    view = sim.scene_view(index, stream)
+    temperature = counts_to_celsius(camera.render_counts(view))
+    # visibility on the thermal camera: people alone vs the full scene
+    hits = view.render(camera.camera, pose)
+    ids, _ = view.surface(hits) if view.surface is not None else (None, None)
+    if ids is None:  # pragma: no cover - the simulator always gives surfaces
+        raise TypeError("the simulator's scene view has no surface ids")
+    hidden = _hidden_ids(sim, index, camera, pose, ids)
+    t_pose = pose.inverse()
+    dist = [
+        float(t_pose.transform_points(np.array([[xy[0], xy[1], 1.0]]))[0, 2])
+        for _, _, _, xy in meshes
+    ]
+    scale, offset = thermal_to_colour(sim, camera)
+    out = []
+    for i, j in found:
+        a, b = boxes[i], boxes[j]
+        if a is None or b is None:  # pragma: no cover - filtered above
             continue
-        size = (float(camera.camera.width), float(camera.camera.height))
-        boxes: tuple[Box, Box] = (_clipped(extents[0], size), _clipped(extents[1], size))
-        if _overlap(*boxes) < MIN_OVERLAP:
-            continue
-        frame = sim.frame(index)
-        view = sim.scene_view(index, 0)
-        temperature = counts_to_celsius(camera.render_counts(view))
-        # visibility on the thermal camera: people alone vs the full scene
-        hits = view.render(camera.camera, pose)
-        ids, _ = view.surface(hits) if view.surface is not None else (None, None)
-        if ids is None:  # pragma: no cover - the simulator always gives surfaces
-            raise TypeError("the simulator's scene view has no surface ids")
-        hidden = _hidden_ids(sim, index, camera, pose, ids)
         visible = (
-            _visible_share(ids, boxes[0], meshes[0][0], hidden),
-            _visible_share(ids, boxes[1], meshes[1][0], hidden),
+            _visible_share(ids, a, meshes[i][0], hidden),
+            _visible_share(ids, b, meshes[j][0], hidden),
         )
         if jitter > 0.0:
-            boxes = (_jittered(boxes[0], jitter, rng), _jittered(boxes[1], jitter, rng))
-        t_pose = pose.inverse()
-        dist = tuple(
-            float(t_pose.transform_points(np.array([[xy[0], xy[1], 1.0]]))[0, 2])
-            for _, _, _, xy in meshes
+            a, b = _jittered(a, jitter, rng), _jittered(b, jitter, rng)
+        out.append(
+            RenderedPair(temperature, frame.rgb, (a, b), (dist[i], dist[j]), visible, scale, offset)
         )
-        scale, offset = thermal_to_colour(sim, camera)
-        return RenderedPair(
-            temperature, frame.rgb, boxes, (dist[0], dist[1]), visible, scale, offset
-        )
-    raise ValueError(f"no overlapping pair in {_MAX_TRIES} draws")
+    return out
+
+
+#: The stream of the box jitter of :func:`scene_pairs` (apart from the simulator's streams).
+SCENE_JITTER_STREAM = 91
+
+
+def scene_pairs(
+    scenario: Scenario, jitter: float = 0.0, stride: int = 1, limit: int | None = None
+) -> Iterator[RenderedPair]:
+    """Overlapping pairs of people in a scenario's own frames, with its seed.
+
+    Frames ``0, stride, 2 stride, ...``: in each, every pair of people whose thermal boxes
+    (cut to the image) overlap by :data:`MIN_OVERLAP` (:func:`_frame_pairs`), at most
+    ``limit`` pairs in all. The boxes' jitter of frame ``k`` is drawn from numpy
+    ``default_rng([seed, SCENE_JITTER_STREAM, k])``, so a pair is a pure function of the
+    scenario, its seed and the frame. Person ``a`` of a pair is the one listed first in the
+    scenario.
+    """
+    if jitter < 0.0:
+        raise ValueError(f"jitter={jitter} must be non-negative")
+    if stride < 1:
+        raise ValueError(f"stride={stride} must be at least 1")
+    if limit is not None and limit < 0:
+        raise ValueError(f"limit={limit} must be non-negative")
+    sim = Simulator(scenario)
+    given = 0
+    for index in range(0, sim.n_frames, stride):
+        if limit is not None and given >= limit:
+            return
+        rng = np.random.default_rng([sim.seed, SCENE_JITTER_STREAM, index])
+        for pair in _frame_pairs(sim, index, rng, jitter):
+            if limit is not None and given >= limit:
+                return
+            given += 1
+            yield pair
 
 
 def _hidden_ids(

@@ -17,13 +17,14 @@ a pure function of the data. scikit-learn is not a dependency of this project an
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from rgbd_eval import exact
 
 F64 = NDArray[np.float64]
 
@@ -177,9 +178,9 @@ def train(
         if err >= 0.5:
             break
         e = min(max(err, _EPS), 1.0 - _EPS)
-        alpha = 0.5 * math.log((1.0 - e) / e)
+        alpha = 0.5 * exact.log((1.0 - e) / e)
         h = np.where(pol * (x[:, j] - thr) > 0, 1, -1)
-        w = w * np.exp(-alpha * y * h)
+        w = w * exact.exp(np.asarray(-alpha * y * h, dtype=np.float64))
         w = w / w.sum()
         stumps.append(Stump(j, thr, pol, alpha))
     return BoostedStumps(tuple(feature_names), tuple(stumps))

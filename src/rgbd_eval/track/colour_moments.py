@@ -23,6 +23,8 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
+
 F64 = NDArray[np.float64]
 
 #: Body regions as (top, bottom) fractions of the box height and their width fraction of
@@ -122,8 +124,8 @@ class IntegralMoments:
         m2 = total(self.s2) / n
         m3 = total(self.s3) / n
         var = np.maximum(m2 - m1 * m1, 0.0)
-        third = m3 - 3.0 * m1 * m2 + 2.0 * m1**3  # E[(p - E)^3] from the raw moments
-        return np.stack([m1, np.sqrt(var), np.cbrt(third)])
+        third = m3 - 3.0 * m1 * m2 + 2.0 * (m1 * m1 * m1)  # E[(p - E)^3] from the raw moments
+        return np.stack([m1, np.sqrt(var), exact.cbrt(third)])
 
     def moments_many(self, boxes: NDArray[np.intp]) -> F64:
         """``(N, 3, C)``: :meth:`moments` of N integer boxes (N, 4) at once."""
@@ -147,8 +149,8 @@ class IntegralMoments:
             m2 = total(self.s2) / n
             m3 = total(self.s3) / n
         var = np.maximum(m2 - m1 * m1, 0.0)
-        third = m3 - 3.0 * m1 * m2 + 2.0 * m1**3
-        out: F64 = np.stack([m1, np.sqrt(var), np.cbrt(third)], axis=1)
+        third = m3 - 3.0 * m1 * m2 + 2.0 * (m1 * m1 * m1)
+        out: F64 = np.stack([m1, np.sqrt(var), exact.cbrt(third)], axis=1)
         out[empty] = np.nan
         return out
 
@@ -278,4 +280,5 @@ def reliability(contrast: float, noise: float, factor: float) -> float:
     possible: no contrast gives 0.0)."""
     if contrast <= 0.0:
         return 0.0
-    return float(contrast**2 / (contrast**2 + (factor * noise) ** 2))
+    c2, n2 = contrast * contrast, (factor * noise) * (factor * noise)
+    return float(c2 / (c2 + n2))

@@ -49,6 +49,7 @@ from typing import Any, Protocol
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.track.adaboost import BoostedStumps
 from rgbd_eval.track.colour_moments import IntegralMoments
@@ -156,7 +157,10 @@ class OcclusionScene:
             if c.ndim != 3 or c.shape[2] != 3:
                 raise ValueError(f"colour image shape {c.shape} must be HxWx3")
             cm = colour_moments if colour_moments is not None else IntegralMoments.of(c)
-            cg = _gradient_integral(c.astype(np.float64) @ _LUMA)
+            cf = c.astype(np.float64)
+            cg = _gradient_integral(
+                cf[..., 0] * _LUMA[0] + cf[..., 1] * _LUMA[1] + cf[..., 2] * _LUMA[2]
+            )
         scale, offset = (
             ((1.0, 1.0), (0.0, 0.0)) if affine is None else (affine.scale, affine.offset)
         )
@@ -229,7 +233,7 @@ def pair_features(a: Box, b: Box, scene: OcclusionScene) -> F64:
     hm = (ha + hb) / 2.0
     f[0] = (a[3] - b[3]) / hm
     f[1] = (a[1] - b[1]) / hm
-    f[2] = math.log(ha / hb)
+    f[2] = exact.log(ha / hb)
     o = intersection(a, b)
     if o is None:
         return f
