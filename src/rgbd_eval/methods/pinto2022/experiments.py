@@ -40,7 +40,7 @@ from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sim.scenario import load_scenario
 from rgbd_eval.sim.synth import ground_truth_path, synthesize
 from rgbd_eval.sweep import point_configs, run_sweep
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
@@ -536,15 +536,7 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
                     f"seed {s}: {'held' if j.held else 'failed'}: {j.evidence}"
                     for s, j in c.per_seed.items()
                 ),
-                "measured": {
-                    name: {
-                        "mean": sp.mean,
-                        "min": sp.low,
-                        "max": sp.high,
-                        "per_seed": {str(s): j.measured.get(name) for s, j in c.per_seed.items()},
-                    }
-                    for name, sp in c.spreads.items()
-                },
+                "measured": spreads_json(c.spreads, {s: j.measured for s, j in c.per_seed.items()}),
             }
             for c in over
         ],
