@@ -26,6 +26,7 @@ LAYERS = [
             "rgbd_eval.exact",
             "rgbd_eval.exact_kernels",
             "rgbd_eval.verdicts",
+            "rgbd_eval.tuning",
             "rgbd_eval.machine",
             "rgbd_eval.files",
             "rgbd_eval.atomic",

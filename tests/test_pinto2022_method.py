@@ -29,7 +29,7 @@ def test_method_defaults_come_from_its_config_file() -> None:
         0.05,
     )
     assert (t.confirm_hits, t.max_misses) == (3, 5)
-    assert (t.t_lower, t.t_upper, t.t_recover) == (0.359, 0.646, 0.486)
+    assert (t.t_lower, t.t_upper, t.t_recover) == (0.305, 0.549, 0.328)
     # the model's defaults agree with the method file
     assert Pinto2022TrackerConfig() == t
     assert config.evaluation.effective_threshold() == 1.0

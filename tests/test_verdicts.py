@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from rgbd_eval.plugins import ReproduceResult
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
 
 
 def test_held_only_when_every_run_holds() -> None:
@@ -50,3 +50,13 @@ def test_tally_and_a_plugins_bool_claims_read_as_one_run() -> None:
     verdicts = [v for _, v in r.verdicts()]
     assert verdicts == [Verdict.HELD, Verdict.FAILED, Verdict.INCONCLUSIVE, Verdict.HELD]
     assert tally(verdicts) == "2 held, 1 failed, 1 inconclusive of 4"
+
+
+def test_spreads_json_gives_mean_least_greatest_and_each_run() -> None:
+    spreads = {"mota": Spread.of([0.8, 0.9]), "gap": Spread.of([0.1])}
+    per_run = {1: {"mota": 0.8, "gap": 0.1}, 2: {"mota": 0.9}}
+    out = spreads_json(spreads, per_run)
+    assert out["mota"]["min"] == 0.8 and out["mota"]["max"] == 0.9
+    assert out["mota"]["mean"] == pytest.approx(0.85)
+    assert out["mota"]["per_seed"] == {"1": 0.8, "2": 0.9}
+    assert out["gap"]["per_seed"] == {"1": 0.1, "2": None}  # seed 2 did not measure it

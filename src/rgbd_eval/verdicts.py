@@ -11,8 +11,9 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 
 class Verdict(enum.Enum):
@@ -65,6 +66,22 @@ class Spread:
         return (
             f"{self.mean:{fmt}}{unit} [{self.low:{fmt}}, {self.high:{fmt}}] over {self.runs} runs"
         )
+
+
+def spreads_json(
+    spreads: Mapping[str, Spread], per_run: Mapping[Any, Mapping[str, float]]
+) -> dict[str, dict[str, Any]]:
+    """A claim's measured values for a report's JSON: per name its mean, least and greatest
+    over the runs and each run's value (None where a run did not measure it)."""
+    return {
+        name: {
+            "mean": sp.mean,
+            "min": sp.low,
+            "max": sp.high,
+            "per_seed": {str(run): values.get(name) for run, values in per_run.items()},
+        }
+        for name, sp in spreads.items()
+    }
 
 
 def tally(verdicts: Sequence[Verdict]) -> str:

@@ -80,3 +80,23 @@ def test_builtin_mobilenet_runs_and_is_deterministic() -> None:
     b = emb.embed(rgb, boxes[:1])
     np.testing.assert_allclose(np.linalg.norm(a, axis=1), 1.0, rtol=1e-5)
     np.testing.assert_allclose(a[:1], b, atol=1e-5)  # batch and single agree
+
+
+def test_colour_texture_uses_no_cpu_dependent_maths(monkeypatch: pytest.MonkeyPatch) -> None:
+    # numpy's arctan2 and hypot (SIMD/SVML by CPU) and BLAS norms can differ in the last bit
+    # between CPUs, and a last bit can move a gradient orientation across a bin edge: the
+    # descriptor (and so pinto2022's calibrated thresholds) must not call them.
+    rng = np.random.default_rng(5)
+    rgb = rng.integers(0, 256, (120, 80, 3), dtype=np.uint8)
+    boxes = [Box2D(4.0, 2.0, 60.0, 110.0)]
+    expected = ColourTextureEmbedder().embed(rgb, boxes)
+
+    def refuse(*_a: object, **_k: object) -> None:
+        raise AssertionError("CPU-dependent maths called")
+
+    monkeypatch.setattr(np, "arctan2", refuse)
+    monkeypatch.setattr(np, "hypot", refuse)
+    monkeypatch.setattr(np.linalg, "norm", refuse)
+    got = ColourTextureEmbedder().embed(rgb, boxes)
+    assert got.tobytes() == expected.tobytes()
+    assert float(np.sqrt(np.sum(got.astype(np.float64) ** 2))) == pytest.approx(1.0, abs=1e-6)

@@ -30,6 +30,8 @@ from rgbd_eval.detect.blobs import blob_mask, find_blobs
 from rgbd_eval.methods.dmtbs.detector import DepthView, DmtbsDetector, DmtbsDetectorConfig
 from rgbd_eval.sim.scenario import load_scenario
 from rgbd_eval.sim.tof import TofRig
+from rgbd_eval.tuning import errors_at as _errors_at
+from rgbd_eval.tuning import fewest_errors
 
 
 def measure(path: Path, gate_m: float) -> tuple[list[float], list[float], int]:
@@ -80,33 +82,17 @@ def measure(path: Path, gate_m: float) -> tuple[list[float], list[float], int]:
 
 def errors_at(people: list[float], false: list[float], t: float) -> int:
     """People not found (their largest near blob below ``t``, or none) + false blobs kept."""
-    return int(sum(a < t or a == 0.0 for a in people) + sum(a >= t for a in false))
+    missed = sum(a == 0.0 for a in people)
+    return missed + _errors_at([a for a in people if a > 0.0], false, t, "at_or_above")
 
 
 def choose(people: list[float], false: list[float]) -> tuple[float, float, float, int]:
-    """The threshold with the fewest errors: the middle of the widest best interval.
-
-    A blob is kept when its surface >= t, so the errors change only at the measured
-    surfaces: t in (v[i-1], v[i]] behaves as v[i]. Returns (threshold, interval low,
-    interval high, errors).
-    """
-    values = sorted({0.0, *(a for a in people if a > 0.0), *false})
-    cuts = [*values, values[-1] + 1.0]
-    errs = [errors_at(people, false, t) for t in cuts]
-    best = min(errs)
-    intervals: list[tuple[float, float]] = []
-    i = 0
-    while i < len(cuts):
-        if errs[i] != best:
-            i += 1
-            continue
-        j = i
-        while j + 1 < len(cuts) and errs[j + 1] == best:
-            j += 1
-        intervals.append((cuts[i - 1] if i > 0 else 0.0, cuts[j]))
-        i = j + 1
-    low, high = max(intervals, key=lambda iv: iv[1] - iv[0])
-    return (low + high) / 2.0, low, high, best
+    """The threshold with the fewest errors: the middle of the widest best interval
+    (:func:`rgbd_eval.tuning.fewest_errors`; a blob is kept when its surface >= t). Returns
+    (threshold, interval low, interval high, errors), the people without a blob counted."""
+    missed = sum(a == 0.0 for a in people)
+    c = fewest_errors([a for a in people if a > 0.0], false, "at_or_above", floor=0.0)
+    return c.value, c.low, c.high, c.errors + missed
 
 
 def main(argv: list[str]) -> int:

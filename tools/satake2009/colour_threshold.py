@@ -10,7 +10,8 @@ when its head point lies within ``--gate`` metres (ground plane) of a ground-tru
 else an object. Its head-torso chroma (:func:`rgbd_eval.methods.satake2009.colour.
 head_torso_chroma`; None: no head) is measured. The chosen threshold is the one with the
 fewest errors (people rejected + objects kept); where several thresholds tie, the middle of
-the best interval. Prints the percentiles per label and the errors at a few thresholds.
+the widest best interval (:func:`rgbd_eval.tuning.fewest_errors`). Prints the percentiles
+per label and the errors at a few thresholds.
 Run it on tuning recordings only: the value is written to
 ``methods/satake2009/method.yaml`` and judged on the scored scenes.
 """
@@ -30,6 +31,7 @@ from rgbd_eval.io.groundtruth import load_ground_truth
 from rgbd_eval.methods.satake2009 import colour, search
 from rgbd_eval.methods.satake2009.detector import Satake2009Detector, head_point
 from rgbd_eval.pipeline import open_for, sidecar_path
+from rgbd_eval.tuning import fewest_errors
 
 
 def measure(path: Path, gate_m: float) -> tuple[list[float], list[float], int, int]:
@@ -68,19 +70,11 @@ def measure(path: Path, gate_m: float) -> tuple[list[float], list[float], int, i
 
 
 def choose(people: list[float], objects: list[float]) -> tuple[float, int]:
-    """The threshold with the fewest errors (middle of the best interval), and the errors."""
-    cuts = sorted({0.0, *people, *objects})
-    cuts.append(cuts[-1] + 1.0)
-    p, o = np.asarray(people), np.asarray(objects)
-    # a match is kept when chroma >= t: the errors of t are people below it, objects at or above
-    errors = [int((p < t).sum() + (o >= t).sum()) for t in cuts]
-    best = min(errors)
-    # t between two neighbouring values behaves as the upper one; the best interval runs from
-    # the value below the first best cut (exclusive) to the last best cut
-    first = errors.index(best)
-    last = len(errors) - 1 - errors[::-1].index(best)
-    low = cuts[first - 1] if first > 0 else 0.0
-    return (low + cuts[last]) / 2.0, best
+    """The threshold with the fewest errors (people rejected + objects kept; a match is kept
+    when chroma >= t), the middle of the widest best interval
+    (:func:`rgbd_eval.tuning.fewest_errors`), and the errors."""
+    c = fewest_errors(people, objects, "at_or_above", floor=0.0)
+    return c.value, c.errors
 
 
 def main(argv: list[str]) -> int:

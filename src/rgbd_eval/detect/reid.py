@@ -25,6 +25,7 @@ import cv2
 import numpy as np
 from numpy.typing import NDArray
 
+from rgbd_eval import exact
 from rgbd_eval.detect.onnx_session import builtin_model, open_session
 from rgbd_eval.errors import ConfigError
 from rgbd_eval.types import Box2D
@@ -202,8 +203,11 @@ class ColourTextureEmbedder:
         grey_img = cv2.cvtColor(tile, cv2.COLOR_RGB2GRAY).astype(np.float32)
         gx = cv2.Sobel(grey_img, cv2.CV_32F, 1, 0, ksize=3).ravel()
         gy = cv2.Sobel(grey_img, cv2.CV_32F, 0, 1, ksize=3).ravel()
-        magnitude = np.hypot(gx, gy)
-        angle = np.mod(np.arctan2(gy, gx), np.pi)  # unsigned orientation
+        # exact.hypot / exact.atan2 / exact.norm: the same bits on every CPU (numpy's hypot,
+        # arctan2 and BLAS norms are not; a last bit can move an orientation across a bin edge)
+        gx64, gy64 = gx.astype(np.float64), gy.astype(np.float64)
+        magnitude = exact.hypot(gx64, gy64)
+        angle = np.mod(exact.atan2(gy64, gx64), exact.PI)  # unsigned orientation
         ob = np.minimum(
             (angle * p.orientation_bins / np.pi).astype(np.int64), p.orientation_bins - 1
         )
@@ -217,7 +221,7 @@ class ColourTextureEmbedder:
             total = hist.sum(axis=1, keepdims=True)
             parts.append(np.sqrt(hist / np.where(total > 0, total, 1.0)))
         vec = np.concatenate(parts, axis=1).ravel()
-        norm = np.linalg.norm(vec)
+        norm = float(exact.norm(vec))
         return np.asarray(vec / norm if norm > 0 else vec, dtype=np.float32)
 
     def embed(self, rgb: NDArray[np.uint8], boxes: Sequence[Box2D]) -> F32:

@@ -44,7 +44,7 @@ from rgbd_eval.sim.rig_config import StaticDepthConfig
 from rgbd_eval.sim.scenario import Obstacle, Scenario, load_scenario
 from rgbd_eval.sim.tof import TofFrame, TofRig
 from rgbd_eval.types import GroundTruthObject, Pose, TrackOutput
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
 
 #: Metric gating distance (m). The seed matches within a threshold distance whose value did
 #: not survive in its text; 0.5 m (methods/dmtbs/method.yaml states why).
@@ -911,15 +911,7 @@ def summarise(paper: Mapping[str, Any], runs: Mapping[int, SeedRun]) -> Reproduc
                 "verdict": c.verdict.value,
                 "held": c.verdict is Verdict.HELD,
                 "per_seed": {str(s): j.held for s, j in c.per_seed.items()},
-                "measured": {
-                    name: {
-                        "mean": sp.mean,
-                        "min": sp.low,
-                        "max": sp.high,
-                        "per_seed": {str(s): j.measured.get(name) for s, j in c.per_seed.items()},
-                    }
-                    for name, sp in c.spreads.items()
-                },
+                "measured": spreads_json(c.spreads, {s: j.measured for s, j in c.per_seed.items()}),
             }
             for c in judged
         ],

@@ -12,8 +12,13 @@ distance distributions of same-person and different-person pairs:
   same person should almost never reach it: the ``upper_quantile`` (99 %) quantile of
   same-person distances;
 - ``T_recover``: an old ID is recovered below it (Algorithm 2), one decision between two
-  populations: the equal-error threshold, where the share of same-person pairs above it
-  equals the share of different-person pairs below it.
+  populations: the distance with the fewest wrong decisions (same-person pairs at or above
+  it + different-person pairs below it), the middle of the widest such interval
+  (:func:`rgbd_eval.tuning.fewest_errors`, the project's rule for a value chosen on tuning
+  data). The equal-error threshold (:func:`equal_error_threshold`) is printed beside it.
+
+Distances are computed in a fixed order from exact operations (:mod:`rgbd_eval.exact`), so
+the same embeddings give the same thresholds, bit for bit, on every CPU.
 
 Where the distributions overlap (as TriNet's do, in the seed's values), this gives the
 seed's ordering ``T_lower < T_recover < T_upper``. Where they are separated, the 1 % of
@@ -28,6 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
+
+from rgbd_eval import exact
+from rgbd_eval.tuning import fewest_errors
 
 FloatArray = NDArray[np.float64]
 
@@ -48,10 +56,10 @@ def pair_distances(
     min_frame_gap: int,
 ) -> tuple[FloatArray, FloatArray]:
     """Euclidean distances of same-person pairs ``min_frame_gap`` or more frames apart, and of
-    different-person pairs (any frames)."""
+    different-person pairs (any frames); summed in index order (no BLAS)."""
     e = np.asarray(embeddings, dtype=np.float64)
-    sq = np.einsum("ij,ij->i", e, e)
-    d2 = sq[:, None] + sq[None, :] - 2.0 * e @ e.T
+    sq = exact.dot(e, e)
+    d2 = sq[:, None] + sq[None, :] - 2.0 * exact.matmul(e, np.ascontiguousarray(e.T))
     d = np.sqrt(np.clip(d2, 0.0, None))
     i, j = np.triu_indices(len(e), k=1)
     same = ids[i] == ids[j]
@@ -95,7 +103,9 @@ def calibrate(
     upper_quantile: float = 0.99,
 ) -> Thresholds:
     """Thresholds by the rules of the module docstring."""
-    t_recover = equal_error_threshold(same, different)
+    if same.size == 0 or different.size == 0:
+        raise ValueError("need same-person and different-person distances")
+    t_recover = fewest_errors(same.tolist(), different.tolist(), keep="below").value
     t_lower = float(np.quantile(different, lower_quantile))
     t_upper = float(np.quantile(same, upper_quantile))
     if t_lower > t_upper:

@@ -3,7 +3,8 @@
 The motion and track-management values are the seed's. The appearance thresholds are
 Euclidean distances in the units of the detector's embedder: the seed's 300 / 700 / 400
 (eqs. 17-18) are TriNet's; the defaults here are those of the default embedder
-(``colour_texture``), calibrated as ``methods/pinto2022/method.yaml`` records.
+(``colour_texture``), calibrated on tuning scenes as ``methods/pinto2022/method.yaml``
+records (tools/pinto2022/calibrate_reid.py).
 ``appearance`` names the embedder the thresholds belong to, so that a detector with
 another embedder is refused instead of being gated in the wrong units.
 """
@@ -28,9 +29,9 @@ class Pinto2022TrackerConfig(ComponentConfig):
     appearance: str = Field(
         "colour_texture", description="the embedder whose units t_lower/t_upper/t_recover are in"
     )
-    t_lower: float = Field(0.359, ge=0.0, description="eq. 17 T_lower, in the embedder's units")
-    t_upper: float = Field(0.646, ge=0.0, description="eq. 17 T_upper, in the embedder's units")
-    t_recover: float = Field(0.486, ge=0.0, description="eq. 18 T_recover, in the embedder's units")
+    t_lower: float = Field(0.305, ge=0.0, description="eq. 17 T_lower, in the embedder's units")
+    t_upper: float = Field(0.549, ge=0.0, description="eq. 17 T_upper, in the embedder's units")
+    t_recover: float = Field(0.328, ge=0.0, description="eq. 18 T_recover, in the embedder's units")
     confirm_hits: int = Field(3, ge=1, description="III-E: associations to confirm a track")
     max_misses: int = Field(5, ge=1, description="III-E: consecutive misses to delete a track")
 
