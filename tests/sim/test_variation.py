@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import hashlib
+import json
 import math
 from typing import Any
 
@@ -115,3 +117,14 @@ def test_the_simulator_renders_the_varied_paths() -> None:
     assert _xy(sim.scenario, 1) == _xy(vary_paths(s, 2), 1)
     assert _xy(sim.scenario, 1) != _xy(s, 1)
     assert _xy(Simulator(_scene(), 2).scenario, 1) == _xy(s, 1)
+
+
+def test_an_unvaried_scene_keeps_the_digest_it_had_before_the_fields() -> None:
+    # The digest of a scene that does not vary its paths leaves the two later fields out, so
+    # its recordings keep their bytes (the demo's provenance, the layout golden hashes).
+    s = _scene()
+    data = s.model_dump(mode="json")
+    del data["vary_paths_m"], data["vary_speed"]
+    text = json.dumps(data, sort_keys=True, separators=(",", ":"))
+    assert s.digest() == hashlib.sha256(text.encode("utf-8")).hexdigest()
+    assert _scene(vary_paths_m=0.3).digest() != s.digest()

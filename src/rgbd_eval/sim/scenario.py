@@ -471,8 +471,17 @@ class Scenario(_Model):
         return self._source_sha256
 
     def digest(self) -> str:
-        """sha256 of the resolved scenario (every value, overrides applied) as canonical JSON."""
-        text = json.dumps(self.model_dump(mode="json"), sort_keys=True, separators=(",", ":"))
+        """sha256 of the resolved scenario (every value, overrides applied) as canonical JSON.
+
+        Fields added after recordings were made (:data:`_LATER_FIELDS`) count only when set,
+        so that a scene that does not use them keeps its digest, and its recordings their
+        bytes.
+        """
+        data = self.model_dump(mode="json")
+        for name, default in _LATER_FIELDS.items():
+            if data.get(name) == default:
+                del data[name]
+        text = json.dumps(data, sort_keys=True, separators=(",", ":"))
         return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
     @property
@@ -485,6 +494,11 @@ class Scenario(_Model):
 
 
 # ----------------------------------------------------------------------------- loading
+
+
+#: Scenario fields added after the first recordings, with the default that leaves them out of
+#: :meth:`Scenario.digest`.
+_LATER_FIELDS: dict[str, float] = {"vary_paths_m": 0.0, "vary_speed": 0.0}
 
 
 def parse_scenario(data: object, source: str = "scenario") -> Scenario:
