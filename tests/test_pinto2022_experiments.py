@@ -235,12 +235,18 @@ def test_each_seed_renders_the_scenes_with_that_seed_beside_the_given_ones(
 ) -> None:
     rendered: list[tuple[str, int, str]] = []
 
-    def fake(scenario: Scenario, path: Path, container: str) -> None:
-        rendered.append((scenario.name, scenario.seed, Path(path).name))
+    def fake(scenario: Scenario, path: Path, container: str, seed: int | None = None) -> None:
+        rendered.append(
+            (scenario.name, seed if seed is not None else scenario.seed, Path(path).name)
+        )
         Path(path).write_bytes(b"")
         ground_truth_path(Path(path)).write_text("")
 
-    monkeypatch.setattr(experiments, "synthesize", fake)
+    import rgbd_eval.sim.synth as synth
+
+    monkeypatch.setattr(synth, "synthesize", fake)
+    # Present counts as current here (the provenance check has its own test in tests/sim).
+    monkeypatch.setattr(synth, "is_current", lambda p, *_a: p.exists())
     given = {"still": tmp_path / "still.mcap", TEST: tmp_path / f"{TEST}.mcap"}
     out = seeded_recordings(given, 3, lambda _m: None)
     assert out == {"still": tmp_path / "still-seed3.mcap", TEST: tmp_path / f"{TEST}-seed3.mcap"}

@@ -275,7 +275,12 @@ def test_seeded_recordings_reuse_the_scenarios_own_seed(
         Path(out).write_bytes(b"")
         Path(out).with_name(f"{Path(out).stem}.gt.csv").write_text("")
 
-    monkeypatch.setattr(experiments, "synthesize", fake)
+    import rgbd_eval.sim.synth as synth
+
+    monkeypatch.setattr(synth, "synthesize", fake)
+    # Present counts as current here (the provenance check has its own test in tests/sim).
+    monkeypatch.setattr(experiments, "is_current", lambda p, *_a: p.exists())
+    monkeypatch.setattr(synth, "is_current", lambda p, *_a: p.exists())
     own = tmp_path / "static_simple.mcap"  # static_simple.yaml has seed 1
     got = seeded_recordings({"static_simple": own}, [1, 2])
     assert got == {
@@ -293,7 +298,8 @@ def test_seeded_recordings_render_on_the_cluster(
     # With a client the missing recordings are rendered as tasks (on 2 cores: two at once).
     from rgbd_eval.engine import connect, parse_cluster
 
-    def fake(scenario: Path, target: Path, seed: int) -> None:
+    def fake(scenario: Path, folder: Path, seed: int) -> None:
+        target = folder / f"{scenario.stem}-seed{seed}.mcap"
         target.write_bytes(str(seed).encode())
         target.with_name(f"{target.stem}.gt.csv").write_text("")
 

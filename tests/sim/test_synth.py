@@ -202,3 +202,38 @@ def test_a_damaged_provenance_is_skipped_with_a_warning(tmp_path: Path) -> None:
     rec = open_recording(bad)
     assert rec.info.provenance is None
     assert any("provenance" in w and "not JSON" in w for w in rec.info.warnings)
+
+
+def test_ensure_scenario_renders_again_what_is_out_of_date(tmp_path: Path, tiny: Scenario) -> None:
+    import rgbd_eval.sim.synth as synth
+    from rgbd_eval.errors import OutputError
+
+    scene = tmp_path / "scene.yaml"
+    data = tiny.model_dump(mode="json")
+    scene.write_text(yaml.safe_dump(data))
+    out = tmp_path / "out"
+    said: list[str] = []
+    own = synth.ensure_scenario(scene, out, said.append)
+    assert own == out / "scene.mcap" and said and "absent" in said[0]
+    other = synth.ensure_scenario(scene, out, said.append, seed=tiny.seed + 7)
+    assert other == out / f"scene-seed{tiny.seed + 7}.mcap"
+    assert synth.is_current(own, scene) and synth.is_current(other, scene, tiny.seed + 7)
+    # Current: not rendered again (the file keeps its modification time and bytes).
+    stamp = own.stat().st_mtime_ns
+    said.clear()
+    assert synth.ensure_scenario(scene, out, said.append) == own
+    assert not said and own.stat().st_mtime_ns == stamp
+    # The scene changed (a person walks elsewhere): its recordings are out of date.
+    data["people"][0]["path"][0]["x"] += 0.5
+    scene.write_text(yaml.safe_dump(data))
+    assert not synth.is_current(own, scene) and not synth.is_current(other, scene, tiny.seed + 7)
+    synth.ensure_scenario(scene, out, said.append)
+    assert said and "out of date" in said[0] and synth.is_current(own, scene)
+    # A file synth did not write is never replaced, current or not.
+    mine = out / "scene-seed99.mcap"
+    mine.write_bytes(b"my own recording")
+    ground_truth_path(mine).write_text("mine")
+    assert not synth.is_current(mine, scene, 99)
+    with pytest.raises(OutputError):
+        synth.ensure_scenario(scene, out, seed=99)
+    assert mine.read_bytes() == b"my own recording"

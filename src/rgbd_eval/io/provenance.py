@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 PROVENANCE_TOPIC = "/rgbd_eval/provenance"
@@ -73,3 +74,22 @@ def differences(a: Mapping[str, Any] | None, b: Mapping[str, Any] | None) -> lis
             "provenance: " + ("missing in both" if a is None and b is None else "missing in one")
         ]
     return [f"{k}: {a.get(k)!r} -> {b.get(k)!r}" for k in IDENTITY_KEYS if a.get(k) != b.get(k)]
+
+
+def read(path: Path) -> dict[str, Any] | None:
+    """The provenance of the recording at ``path`` (its first provenance message), or None
+    when it has none or it cannot be read. Reads only that message, not the images."""
+    from rgbd_eval.errors import InputError
+    from rgbd_eval.io.source import READ_ERRORS, open_source
+
+    errors: tuple[type[BaseException], ...] = (*READ_ERRORS, InputError)
+    try:
+        with open_source(path) as src:
+            conn = src.topics.get(PROVENANCE_TOPIC)
+            if conn is None or conn.msgtype != PROVENANCE_TYPE:
+                return None
+            for _topic, _stamp, raw in src.messages({PROVENANCE_TOPIC}):
+                return decode(str(src.deserialize(raw, PROVENANCE_TYPE).data))
+    except errors:
+        return None
+    return None

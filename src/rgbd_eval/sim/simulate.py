@@ -92,6 +92,8 @@ class Simulator:
         self.seed = scenario.seed if seed is None else int(seed)
         if self.seed < 0:
             raise ValueError(f"seed={self.seed} must be non-negative")
+        #: The scenario as given (its digest and the seed name what is rendered).
+        self.source_scenario = scenario
         #: The scenario as this seed renders it: its paths varied (rgbd_eval.sim.variation).
         self.scenario = scenario = vary_paths(scenario, self.seed)
         s = scenario.sensor

@@ -91,7 +91,7 @@ def provenance(
 
     ``closed_loop`` identifies what drove the robot when the path is not the scenario's.
     """
-    sc = sim.scenario
+    sc = sim.source_scenario  # as written: with the seed, it names the paths walked
     return {
         "generator": "rgbd-eval synth",
         "tool_version": __version__,
@@ -212,21 +212,57 @@ def demo_recording(progress: ProgressCallback | None = None) -> Path:
     return path
 
 
-def ensure_scenario(
-    name_or_path: str, folder: Path | None = None, say: Callable[[str], None] | None = None
-) -> Path:
-    """The recording of a scenario (a name in ``configs/scenarios`` or a YAML path),
-    generated into ``folder`` (default: :func:`dataset_path`) when absent."""
+def scenario_file(name_or_path: str | Path) -> Path:
+    """A scenario's YAML: a path as given, or a name in ``configs/scenarios``."""
     source = Path(name_or_path)
-    yaml_path = (
-        source if source.suffix in (".yaml", ".yml") else scenarios_dir() / f"{name_or_path}.yaml"
-    )
-    name = yaml_path.stem
-    path = dataset_path(name) if folder is None else Path(folder) / f"{name}.mcap"
+    return source if source.suffix in (".yaml", ".yml") else scenarios_dir() / f"{source}.yaml"
+
+
+def recording_path(yaml_path: Path, folder: Path | None = None, seed: int | None = None) -> Path:
+    """Where :func:`ensure_scenario` keeps a scenario's recording at ``seed``:
+    ``<name>.mcap`` at the scenario's own seed, ``<name>-seed<seed>.mcap`` at another, in
+    ``folder`` (default: :func:`dataset_path`)."""
+    own = seed is None or seed == load_scenario(yaml_path).seed
+    stem = yaml_path.stem if own else f"{yaml_path.stem}-seed{seed}"
+    return dataset_path(stem) if folder is None else Path(folder) / f"{stem}.mcap"
+
+
+def is_current(path: Path, yaml_path: Path, seed: int | None = None) -> bool:
+    """Whether the recording at ``path`` is what rendering the scenario at ``seed`` (default:
+    its own) makes now: present with its ground truth, and its provenance names the same
+    scenario digest, seed and renderer version (else the scene file or the renderer changed
+    since it was made)."""
+    from rgbd_eval.io.provenance import read
+
     if not path.exists() or not ground_truth_path(path).exists():
-        if say is not None:
-            say(f"generating {path} ...")
-        synthesize(load_scenario(yaml_path), path, "mcap")
+        return False
+    scenario = load_scenario(yaml_path)
+    prov = read(path)
+    return prov is not None and (
+        prov.get("scenario_sha256") == scenario.digest()
+        and prov.get("seed") == (scenario.seed if seed is None else seed)
+        and prov.get("renderer_version") == RENDERER_VERSION
+    )
+
+
+def ensure_scenario(
+    name_or_path: str | Path,
+    folder: Path | None = None,
+    say: Callable[[str], None] | None = None,
+    seed: int | None = None,
+) -> Path:
+    """The recording of a scenario (a name in ``configs/scenarios`` or a YAML path) at
+    ``seed`` (default: the scenario's own), at :func:`recording_path` in ``folder``;
+    rendered when absent or not :func:`is_current` (``synth`` replaces only the files it
+    wrote: a user's file of that name is an OutputError, never replaced)."""
+    yaml_path = scenario_file(name_or_path)
+    path = recording_path(yaml_path, folder, seed)
+    if is_current(path, yaml_path, seed):
+        return path
+    if say is not None:
+        state = "out of date (the scene or the renderer changed)" if path.exists() else "absent"
+        say(f"generating {path} ({state}) ...")
+    synthesize(load_scenario(yaml_path), path, "mcap", seed=seed)
     return path
 
 

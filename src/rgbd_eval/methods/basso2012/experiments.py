@@ -42,11 +42,10 @@ from rgbd_eval.pipeline import (
     match_ground_truth,
     open_for,
     sequence_name,
-    sidecar_path,
     track_sequence,
 )
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
-from rgbd_eval.sim import load_scenario, synthesize
+from rgbd_eval.sim.synth import ensure_scenario, is_current, recording_path
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
@@ -121,12 +120,13 @@ def seeded_recordings(
     progress: Progress | None = None,
     client: Client | None = None,
 ) -> dict[int, dict[str, Path]]:
-    """Per seed, each scenario's recording rendered with that seed (generated when absent,
-    on ``client``'s workers when given).
+    """Per seed, each scenario's recording rendered with that seed (when absent or out of
+    date, :func:`rgbd_eval.sim.synth.is_current`; on ``client``'s workers when given).
 
     ``recordings`` are the scenarios' own (their YAML's ``seed``), named as in
     ``configs/scenarios``; at that seed the recording is reused (same scenario and seed give
-    the same bytes), at another it is ``<stem>-seed<k>.mcap`` beside it.
+    the same bytes), at another it is ``<stem>-seed<k>.mcap`` beside it
+    (:func:`rgbd_eval.sim.synth.recording_path`).
     """
     say = progress or (lambda _msg: None)
     out: dict[int, dict[str, Path]] = {}
@@ -135,12 +135,9 @@ def seeded_recordings(
         out[seed] = {}
         for name, path in recordings.items():
             source = scenarios_dir() / f"{name}.yaml"
-            if load_scenario(source).seed == seed:
-                out[seed][name] = path
-                continue
-            target = path.with_name(f"{sequence_name(path)}-seed{seed}.mcap")
-            if not target.exists() or sidecar_path(target) is None:
-                missing.append((source, target, seed))
+            target = recording_path(source, path.parent, seed)
+            if target != path and not is_current(target, source, seed):
+                missing.append((source, path.parent, seed))
             out[seed][name] = target
     if missing:
         say(f"generating {len(missing)} recordings at the other scenario seeds ...")
@@ -152,9 +149,10 @@ def seeded_recordings(
     return out
 
 
-def render_seeded(scenario: Path, target: Path, seed: int) -> None:
-    """``synth`` of the scenario file at ``seed`` to ``target`` (a task of :func:`seeded_recordings`)."""
-    synthesize(load_scenario(scenario), target, "mcap", seed=seed)
+def render_seeded(scenario: Path, folder: Path, seed: int) -> None:
+    """The scenario file's recording at ``seed`` in ``folder`` (a task of
+    :func:`seeded_recordings`)."""
+    ensure_scenario(scenario, folder, seed=seed)
 
 
 @dataclass(frozen=True)

@@ -71,16 +71,12 @@ def scenario_file(name: str) -> Path:
 
 
 def seeded_recording(name: str, seed: int, folder: Path | None) -> Path:
-    """The recording of scored scene ``name`` at scenario ``seed``, rendered when absent
-    (``<folder>/<name>_s<seed>.mcap``; default folder: the generated datasets)."""
-    from rgbd_eval.sim.scenario import load_scenario
-    from rgbd_eval.sim.synth import dataset_path, ground_truth_path, synthesize
+    """The recording of scored scene ``name`` at scenario ``seed``, rendered when absent or
+    out of date (:func:`rgbd_eval.sim.synth.ensure_scenario`: ``<name>-seed<seed>.mcap`` in
+    ``folder``; default folder: the generated datasets)."""
+    from rgbd_eval.sim.synth import ensure_scenario
 
-    stem = f"{name}_s{seed}"
-    path = dataset_path(stem) if folder is None else Path(folder) / f"{stem}.mcap"
-    if not path.exists() or not ground_truth_path(path).exists():
-        synthesize(load_scenario(scenario_file(name), [("seed", seed)]), path, "mcap")
-    return path
+    return ensure_scenario(scenario_file(name), folder, seed=seed)
 
 
 def _overlaps(a: Box2D, b: Box2D) -> bool:

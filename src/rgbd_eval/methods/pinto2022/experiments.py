@@ -37,8 +37,7 @@ from rgbd_eval.methods.pinto2022.tracker_config import Pinto2022TrackerConfig
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
-from rgbd_eval.sim.scenario import load_scenario
-from rgbd_eval.sim.synth import ground_truth_path, synthesize
+from rgbd_eval.sim.synth import ensure_scenario
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
 
@@ -359,18 +358,14 @@ def seeded_recordings(
     recordings: Mapping[str, Path], seed: int, say: Callable[[str], None]
 ) -> dict[str, Path]:
     """The given scenes rendered with scenario seed ``seed`` beside their recordings
-    (``<scene>-seed<seed>.mcap``, rendered only when absent)."""
-    out: dict[str, Path] = {}
-    for name, path in recordings.items():
-        target = path.parent / f"{name}-seed{seed}.mcap"
-        if not target.exists() or not ground_truth_path(target).exists():
-            say(f"generating {target} ...")
-            scenario = load_scenario(
-                scenarios_dir() / "pinto2022" / f"{name}.yaml", [("seed", seed)]
-            )
-            synthesize(scenario, target, "mcap")
-        out[name] = target
-    return out
+    (:func:`rgbd_eval.sim.synth.ensure_scenario`: ``<scene>-seed<seed>.mcap``, rendered
+    only when absent or out of date)."""
+    return {
+        name: ensure_scenario(
+            scenarios_dir() / "pinto2022" / f"{name}.yaml", path.parent, say, seed=seed
+        )
+        for name, path in recordings.items()
+    }
 
 
 def measure(
