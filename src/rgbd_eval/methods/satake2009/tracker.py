@@ -90,7 +90,7 @@ class Satake2009TrackerConfig(ComponentConfig):
     min_search_radius_px: float = Field(6.0, ge=1.0, description="smallest window radius")
     max_search_radius_px: float = Field(48.0, ge=1.0, description="largest window radius")
     search_rows: int = Field(
-        24, ge=8, le=512, description="search where the tallest template is this tall"
+        40, ge=8, le=512, description="search where the tallest template is this tall"
     )
     search_distance_ratio: float = Field(
         1.08, gt=1.0, le=1.5, description="step r of the distances D r^k around the predicted D"
