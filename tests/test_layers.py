@@ -47,6 +47,7 @@ LAYERS = [
         "sim: motion and bodies",
         [
             "rgbd_eval.sim.motion",
+            "rgbd_eval.sim.variation",
             "rgbd_eval.sim.odometry",
             "rgbd_eval.sim.meshes",
             "rgbd_eval.sim.body",
