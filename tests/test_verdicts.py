@@ -60,3 +60,21 @@ def test_spreads_json_gives_mean_least_greatest_and_each_run() -> None:
     assert out["mota"]["mean"] == pytest.approx(0.85)
     assert out["mota"]["per_seed"] == {"1": 0.8, "2": 0.9}
     assert out["gap"]["per_seed"] == {"1": 0.1, "2": None}  # seed 2 did not measure it
+
+
+def test_over_seeds_judges_a_claim_on_every_seed_or_calls_it_inconclusive() -> None:
+    from rgbd_eval.verdicts import over_seeds
+
+    # Held on seeds 1 and 2, with gains of 3 and 5 points: held, mean 4 [3, 5].
+    verdict, spreads = over_seeds([1, 2], {1: True, 2: True}, {1: {"gain": 3.0}, 2: {"gain": 5.0}})
+    assert verdict is Verdict.HELD
+    assert (spreads["gain"].mean, spreads["gain"].low, spreads["gain"].high) == (4.0, 3.0, 5.0)
+    # Failed on both: failed.
+    assert over_seeds([1, 2], {1: False, 2: False}, {})[0] is Verdict.FAILED
+    # Held on 1, not judged on 2 (its row missing, or None): inconclusive, not held; the
+    # spread is over the one seed that measured it.
+    verdict, spreads = over_seeds([1, 2], {1: True}, {1: {"gain": 3.0}})
+    assert verdict is Verdict.INCONCLUSIVE and spreads["gain"].runs == 1
+    assert over_seeds([1, 2], {1: True, 2: None}, {})[0] is Verdict.INCONCLUSIVE
+    # Flips: inconclusive.
+    assert over_seeds([1, 2], {1: True, 2: False}, {})[0] is Verdict.INCONCLUSIVE

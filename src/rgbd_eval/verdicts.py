@@ -68,6 +68,30 @@ class Spread:
         )
 
 
+def over_seeds(
+    seeds: Sequence[Any],
+    held: Mapping[Any, bool | None],
+    measured: Mapping[Any, Mapping[str, float]],
+) -> tuple[Verdict, dict[str, Spread]]:
+    """One claim over ``seeds``: its verdict and the spread of each value it measured.
+
+    ``held`` and ``measured`` are by seed. A seed on which the claim was not judged
+    (absent from ``held``, or None: a row or a variant missing there) makes it
+    inconclusive: a claim is held or failed only when judged the same way on every seed.
+    """
+    if not seeds:
+        raise ValueError("a verdict needs at least one seed")
+    judged = [held.get(s) for s in seeds]
+    verdict = (
+        Verdict.INCONCLUSIVE
+        if any(h is None for h in judged)
+        else over_runs([bool(h) for h in judged])
+    )
+    names = dict.fromkeys(n for s in seeds for n in measured.get(s, {}))
+    spreads = {n: Spread.of([measured.get(s, {}).get(n, math.nan) for s in seeds]) for n in names}
+    return verdict, spreads
+
+
 def spreads_json(
     spreads: Mapping[str, Spread], per_run: Mapping[Any, Mapping[str, float]]
 ) -> dict[str, dict[str, Any]]:

@@ -48,7 +48,7 @@ from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sim.synth import ensure_scenario, is_current, recording_path
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, tally
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -910,8 +910,9 @@ class SeededReproduction:
 
 
 def verdicts(runs: Mapping[int, Reproduction]) -> list[ClaimVerdict]:
-    """Each claim over the seeds it was judged on: held on every one, failed on every one,
-    else inconclusive (:func:`rgbd_eval.verdicts.over_runs`), with its measured spreads."""
+    """Each claim over the seeds: held on every one, failed on every one, else inconclusive,
+    also when it was not judged on some seed (:func:`rgbd_eval.verdicts.over_seeds`), with
+    its measured spreads."""
     if not runs:
         raise ValueError("a verdict needs at least one seed's run")
     judged: dict[str, dict[int, Claim]] = {}
@@ -921,11 +922,11 @@ def verdicts(runs: Mapping[int, Reproduction]) -> list[ClaimVerdict]:
     out = []
     for sentence, per_seed in judged.items():
         first = next(iter(per_seed.values()))
-        spreads = {
-            name: Spread.of([c.measured.get(name, math.nan) for c in per_seed.values()])
-            for name in first.measured
-        }
-        verdict = over_runs([c.held for c in per_seed.values()])
+        verdict, spreads = over_seeds(
+            list(runs),
+            {s: c.held for s, c in per_seed.items()},
+            {s: c.measured for s, c in per_seed.items()},
+        )
         out.append(ClaimVerdict(sentence, first.source, first.text, verdict, per_seed, spreads))
     return out
 

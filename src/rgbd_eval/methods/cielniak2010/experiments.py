@@ -40,7 +40,7 @@ from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.types import Box2D
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, tally
 
 #: The summary measures shown per ablation variant.
 MEASURES = ("mota", "motp", "idf1", "id_switches", "fn_rate", "fp_rate")
@@ -315,16 +315,11 @@ def verdicts(per_seed: Mapping[int, Sequence[Judgement]]) -> list[ClaimVerdict]:
         judged = {s: per_seed[s][i] for s in seeds}
         if any(j.key != first.key for j in judged.values()):
             raise ValueError(f"claim {i} differs between seeds")
-        helds = [j.held for j in judged.values()]
-        verdict = (
-            Verdict.INCONCLUSIVE
-            if any(h is None for h in helds)
-            else over_runs([bool(h) for h in helds])
+        verdict, spreads = over_seeds(
+            seeds,
+            {s: j.held for s, j in judged.items()},
+            {s: j.measured for s, j in judged.items()},
         )
-        names = list(dict.fromkeys(n for j in judged.values() for n in j.measured))
-        spreads = {
-            n: Spread.of([judged[s].measured.get(n, math.nan) for s in seeds]) for n in names
-        }
         out.append(ClaimVerdict(first.key, first.source, first.sentence, verdict, judged, spreads))
     return out
 

@@ -44,7 +44,7 @@ from rgbd_eval.sim.rig_config import StaticDepthConfig
 from rgbd_eval.sim.scenario import Obstacle, Scenario, load_scenario
 from rgbd_eval.sim.tof import TofFrame, TofRig
 from rgbd_eval.types import GroundTruthObject, Pose, TrackOutput
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
 
 #: Metric gating distance (m). The seed matches within a threshold distance whose value did
 #: not survive in its text; 0.5 m (methods/dmtbs/method.yaml states why).
@@ -860,11 +860,11 @@ def verdicts(per_seed: Mapping[int, Sequence[Judgement]]) -> list[ClaimVerdict]:
         judged = {s: per_seed[s][i] for s in seeds}
         if any(j.key != first.key for j in judged.values()):
             raise ValueError(f"claim {i} differs between seeds")
-        spreads = {
-            name: Spread.of([judged[s].measured.get(name, math.nan) for s in seeds])
-            for name in first.measured
-        }
-        verdict = over_runs([j.held for j in judged.values()])
+        verdict, spreads = over_seeds(
+            seeds,
+            {s: j.held for s, j in judged.items()},
+            {s: j.measured for s, j in judged.items()},
+        )
         out.append(ClaimVerdict(first.key, first.sentence, verdict, judged, spreads))
     return out
 

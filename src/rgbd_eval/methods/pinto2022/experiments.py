@@ -39,7 +39,7 @@ from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sim.synth import ensure_scenario
 from rgbd_eval.sweep import point_configs, run_sweep
-from rgbd_eval.verdicts import Spread, Verdict, over_runs, spreads_json, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
@@ -436,9 +436,9 @@ class ClaimVerdict:
 
 
 def verdicts(per_seed: Mapping[int, Sequence[Claim]]) -> list[ClaimVerdict]:
-    """Each claim over the seeds (:func:`rgbd_eval.verdicts.over_runs`), with the spread of
+    """Each claim over the seeds (:func:`rgbd_eval.verdicts.over_seeds`), with the spread of
     each value it measured. A claim judged on only some seeds (its row missing on others) is
-    judged over those."""
+    inconclusive."""
     if not per_seed:
         raise ValueError("a verdict needs at least one seed")
     keys: list[str] = []
@@ -448,12 +448,11 @@ def verdicts(per_seed: Mapping[int, Sequence[Claim]]) -> list[ClaimVerdict]:
     for key in keys:
         judged = {s: c for s, claims in per_seed.items() for c in claims if c.key == key}
         first = next(iter(judged.values()))
-        names = [n for c in judged.values() for n in c.measured]
-        spreads = {
-            n: Spread.of([c.measured.get(n, math.nan) for c in judged.values()])
-            for n in dict.fromkeys(names)
-        }
-        verdict = over_runs([c.held for c in judged.values()])
+        verdict, spreads = over_seeds(
+            list(per_seed),
+            {s: c.held for s, c in judged.items()},
+            {s: c.measured for s, c in judged.items()},
+        )
         out.append(ClaimVerdict(key, first.source, first.text, verdict, judged, spreads))
     return out
 
