@@ -48,7 +48,7 @@ from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sim.synth import ensure_scenario, is_current, recording_path
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -1134,15 +1134,7 @@ def seeds_json(res: SeededReproduction, paper: Mapping[str, Any]) -> dict[str, A
                 "held": v.verdict is Verdict.HELD,
                 "per_seed": {str(s): c.held for s, c in v.per_seed.items()},
                 "evidence": v.evidence(),
-                "measured": {
-                    name: {
-                        "mean": sp.mean,
-                        "min": sp.low,
-                        "max": sp.high,
-                        "per_seed": {str(s): c.measured.get(name) for s, c in v.per_seed.items()},
-                    }
-                    for name, sp in v.spreads.items()
-                },
+                "measured": spreads_json(v.spreads, {s: c.measured for s, c in v.per_seed.items()}),
             }
             for v in res.verdicts
         ],

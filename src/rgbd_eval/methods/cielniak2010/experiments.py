@@ -40,7 +40,7 @@ from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.types import Box2D
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, tally
+from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
 
 #: The summary measures shown per ablation variant.
 MEASURES = ("mota", "motp", "idf1", "id_switches", "fn_rate", "fp_rate")
@@ -467,15 +467,7 @@ def summarise(
                 "held": c.verdict is Verdict.HELD,
                 "per_seed": {str(s): j.held for s, j in c.per_seed.items()},
                 "evidence": _evidence(c),
-                "measured": {
-                    n: {
-                        "mean": sp.mean,
-                        "min": sp.low,
-                        "max": sp.high,
-                        "per_seed": {str(s): j.measured.get(n) for s, j in c.per_seed.items()},
-                    }
-                    for n, sp in c.spreads.items()
-                },
+                "measured": spreads_json(c.spreads, {s: j.measured for s, j in c.per_seed.items()}),
             }
             for c in judged
         ],
