@@ -7,7 +7,7 @@ than fitted, cut person windows unscored). Every table is produced by the sweep 
 setting) and shown beside the published values from ``methods/basso2012/paper.yaml``.
 
 Everything is redone on each scenario seed of ``paper.yaml``'s ``seeds`` (each draws other
-people and sensor noise; :func:`seeded_recordings`), each claim of the thesis is checked by a
+people, paths and sensor noise; :func:`seeded_recordings`), each claim of the thesis is checked by a
 small predicate on each seed's numbers, and the verdict is taken over the seeds
 (:func:`rgbd_eval.verdicts.over_runs`): held when held on every seed, failed when failed on
 every seed, else inconclusive; the measured values' spread is shown beside it. Figure 7.9's

@@ -1,8 +1,9 @@
 """Seed 004's evaluation (section 7) on the synthetic thermal scenarios (``reproduce cielniak2010``).
 
 Everything runs on every scenario seed of ``methods/cielniak2010/paper.yaml`` (``seeds``):
-each seed draws other bodies and hair for the scenes' people and other sensor noise, and
-its recordings are rendered once (``<scene>_s<seed>.mcap`` in the data folder). The
+each seed draws other bodies and hair for the scenes' people, other paths
+(:mod:`rgbd_eval.sim.variation`) and other sensor noise, and its recordings are rendered once
+(``<scene>-seed<seed>.mcap`` in the data folder). The
 tracker's own (particle-filter) seed of a run is the scenario seed.
 
 - The data: the share of person instances occluded by another person, per scenario, from
@@ -536,7 +537,7 @@ def render(
         "scenario seeds",
         "",
         f"Scenario seeds {', '.join(map(str, seeds))}: each draws other bodies and hair for the "
-        "scenes' people and other sensor noise; the tracker's particle-filter seed is the "
+        "scenes' people, other paths and other sensor noise; the tracker's particle-filter seed is the "
         "scenario seed. A claim is held when it holds on every seed, failed when it fails on "
         "every seed, else inconclusive; beside it, what it compared: mean [least, greatest] "
         "over the seeds.",

@@ -9,8 +9,8 @@ runs on the same frames as they stream by (:func:`run_setups`).
 Each claim of ``methods/dmtbs/paper.yaml`` is judged on every scenario seed of its ``seeds``
 and the verdict is taken over them (:func:`rgbd_eval.verdicts.over_runs`): held when held on
 every seed, failed when failed on every seed, else inconclusive; the measured values' spread
-is shown beside it. Each seed draws other bodies and clothes for the scenes' people and other
-sensor noise, and looks at its own part of scenes 1 and 2 (:func:`window_start`): the seed
+is shown beside it. Each seed draws other bodies and clothes for the scenes' people, other
+paths and other sensor noise, and looks at its own part of scenes 1 and 2 (:func:`window_start`): the seed
 ran seven sequences of 100 s per setting, ours are a few seconds per seed. Each of those
 short runs starts like a sequence: its background is learnt without the people
 (:func:`window`), and the first :data:`WARMUP_S` after that is not scored (see there why);
@@ -959,7 +959,7 @@ def render_markdown(
         f"# Reproduction of dmtbs (seed 003, 4.3 and 6) over {n} scenario seeds, in memory",
         "",
         f"Scenario seeds {', '.join(map(str, seeds))}: each draws other bodies and clothes for "
-        "the scenes' people and other sensor noise, and looks at its own part of scenes 1 and "
+        "the scenes' people, other paths and other sensor noise, and looks at its own part of scenes 1 and "
         "2, spread evenly over each ("
         + ", ".join(
             f"seed {s}: scene 1 from {r.starts.get('scene1', 0.0):g} s, scene 2 from "

@@ -603,8 +603,8 @@ def render(
     out = [
         "# pinto2022: seed 001 section V on the synthetic Re-ID scenarios",
         "",
-        f"{len(seeds)} scenario seeds ({', '.join(map(str, seeds))}): each draws other people "
-        "and sensor noise for the eight scenes. A claim is held when it holds on every seed, "
+        f"{len(seeds)} scenario seeds ({', '.join(map(str, seeds))}): each draws other people, "
+        "paths and sensor noise for the eight scenes. A claim is held when it holds on every seed, "
         "failed when it fails on every seed, else inconclusive; the spread (mean [min, max]) "
         "of what it measured is beside it.",
         "",

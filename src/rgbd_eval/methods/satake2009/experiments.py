@@ -364,7 +364,7 @@ def render_markdown(
         "",
         f"Scenario {s0.scenario} ({s0.frames} frames at 20 fps, stereo pair at 512x384), on "
         f"{len(seeds)} scenario seeds ({', '.join(map(str, seeds))}: each draws other people, "
-        "bodies and clothes, and other sensor noise): the robot follows person A with path C "
+        "bodies and clothes, other paths and other sensor noise): the robot follows person A with path C "
         "(section 3; v, k, d are ours, see src/rgbd_eval/methods/satake2009/follow.py) while B "
         "and C cross between them; the satake2009 tracker runs online. Metric gating (1 m). "
         "The seed reports this experiment only in pictures: its claims are checked, there is "
