@@ -88,7 +88,8 @@ def test_outside_method_runs_through_every_command(toy_recording: Path, tmp_path
     assert data["method"] == "toy" and set(data["mota"]) == {"0.25", "1.0"}
     # The CPU time of the whole command, split (the toy experiments render nothing).
     cpu = data["cpu_total_s"]
-    assert set(cpu) == {"generate", "experiments"} and cpu["experiments"] > 0.0
+    assert set(cpu) == {"generate", "experiments", "rendered_in_experiments"}
+    assert cpu["experiments"] > 0.0 and cpu["rendered_in_experiments"] == 0.0
     assert "CPU time: " in (tmp_path / "rep" / "reproduce.md").read_text()
     assert "CPU time: " in (tmp_path / "rep" / "reproduce.html").read_text()
     listing = _cli("reproduce", cwd=tmp_path)

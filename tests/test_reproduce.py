@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import time
 from pathlib import Path
 
 import pytest
@@ -274,6 +276,9 @@ def test_seeded_recordings_reuse_the_scenarios_own_seed(
         made.append((Path(out).name, seed))
         Path(out).write_bytes(b"")
         Path(out).with_name(f"{Path(out).stem}.gt.csv").write_text("")
+        start = time.process_time()
+        while time.process_time() - start < 0.02:  # rendering takes CPU
+            pass
 
     import rgbd_eval.sim.synth as synth
 
@@ -282,7 +287,10 @@ def test_seeded_recordings_reuse_the_scenarios_own_seed(
     monkeypatch.setattr(experiments, "is_current", lambda p, *_a: p.exists())
     monkeypatch.setattr(synth, "is_current", lambda p, *_a: p.exists())
     own = tmp_path / "static_simple.mcap"  # static_simple.yaml has seed 1
+    rendering = synth.rendering_cpu_s()
     got = seeded_recordings({"static_simple": own}, [1, 2])
+    # the one rendering's CPU (>= 0.02 s) is counted once, as rendering (reproduce's CPU line)
+    assert 0.02 <= synth.rendering_cpu_s() - rendering < 1.0
     assert got == {
         1: {"static_simple": own},
         2: {"static_simple": tmp_path / "static_simple-seed2.mcap"},
@@ -296,21 +304,27 @@ def test_seeded_recordings_render_on_the_cluster(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     # With a client the missing recordings are rendered as tasks (on 2 cores: two at once).
+    import rgbd_eval.sim.synth as synth
     from rgbd_eval.engine import connect, parse_cluster
 
-    def fake(scenario: Path, folder: Path, seed: int) -> None:
+    def fake(scenario: Path, folder: Path, seed: int) -> tuple[int, float]:
         target = folder / f"{scenario.stem}-seed{seed}.mcap"
         target.write_bytes(str(seed).encode())
         target.with_name(f"{target.stem}.gt.csv").write_text("")
+        # seed 2 as if rendered by a worker process (2.5 s), seed 3 in this process (whose
+        # rendering ensure_scenario counted already: not again)
+        return (os.getpid() + 1, 2.5) if seed == 2 else (os.getpid(), 9.0)
 
     monkeypatch.setattr(experiments, "render_seeded", fake)
     own = tmp_path / "moving_obstacles.mcap"  # moving_obstacles.yaml has seed 6
+    rendering = synth.rendering_cpu_s()
     with connect(parse_cluster("local:1")) as client:
         got = seeded_recordings({"moving_obstacles": own}, [2, 3], client=client)
     assert [p.read_bytes() for p in (got[2]["moving_obstacles"], got[3]["moving_obstacles"])] == [
         b"2",
         b"3",
     ]
+    assert synth.rendering_cpu_s() - rendering == 2.5
 
 
 def test_claims_render_with_their_sentences() -> None:

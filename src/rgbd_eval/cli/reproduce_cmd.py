@@ -33,14 +33,18 @@ def cpu_seconds() -> float:
     return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
-def cpu_summary(generate_s: float, experiments_s: float, data: dict[str, object]) -> str:
+def cpu_summary(
+    generate_s: float, experiments_s: float, data: dict[str, object], seeded_s: float = 0.0
+) -> str:
     """One line on where the CPU went: generating recordings, rendering inside, the method.
 
-    A paper's experiments that render scenes themselves (per seed or per camera layout)
-    report that share as ``data["cpu_s"]["render"]``.
+    Rendering inside the experiments is ``seeded_s`` (recordings at other scenario seeds,
+    :func:`rgbd_eval.sim.synth.rendering_cpu_s`) plus what a paper's experiments that render
+    scenes their own way (closed loops, camera layouts) report as ``data["cpu_s"]["render"]``.
     """
     inner = data.get("cpu_s")
-    render_inside = float(inner.get("render", 0.0)) if isinstance(inner, dict) else 0.0
+    own = float(inner.get("render", 0.0)) if isinstance(inner, dict) else 0.0
+    render_inside = own + seeded_s
     render = generate_s + render_inside
     method = max(0.0, experiments_s - render_inside)
     return (
@@ -88,7 +92,7 @@ def reproduce(
     from rgbd_eval.cache import DetectionCache
     from rgbd_eval.engine import connect, parse_cluster
     from rgbd_eval.report.html.pages import reproduce_page
-    from rgbd_eval.sim.synth import ensure_scenario
+    from rgbd_eval.sim.synth import ensure_scenario, rendering_cpu_s
     from rgbd_eval.sweep import warm_up
 
     # Every option is checked before the scenarios are generated (that takes minutes).
@@ -106,6 +110,7 @@ def reproduce(
             for name in spec.scenarios
         }
         cpu_generated = cpu_seconds()
+        seeded_start = rendering_cpu_s()
         with connect(cluster_spec, warm_up=warm_up) as client:
             options = ReproduceOptions(
                 client=client,
@@ -117,15 +122,17 @@ def reproduce(
         # After the cluster's shutdown, so that its workers' CPU is counted (a remote
         # cluster's is not: the figure is then this process's only).
         generate_s, experiments_s = cpu_generated - cpu_start, cpu_seconds() - cpu_generated
+        seeded_s = rendering_cpu_s() - seeded_start
         payload = {
             "method": system,
             **result.data,
             "cpu_total_s": {
                 "generate": round(generate_s, 1),
                 "experiments": round(experiments_s, 1),
+                "rendered_in_experiments": round(seeded_s, 1),
             },
         }
-        line = cpu_summary(generate_s, experiments_s, dict(result.data))
+        line = cpu_summary(generate_s, experiments_s, dict(result.data), seeded_s)
         result = replace(result, markdown=f"{result.markdown.rstrip()}\n\n{line}\n")
         staging = folder.staging
         write_text(staging / "reproduce.md", result.markdown)

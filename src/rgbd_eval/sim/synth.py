@@ -245,6 +245,22 @@ def is_current(path: Path, yaml_path: Path, seed: int | None = None) -> bool:
     )
 
 
+#: CPU seconds spent rendering by :func:`ensure_scenario` for this process, including
+#: what other processes report back through :func:`add_rendering_cpu`.
+_RENDERING_CPU_S = [0.0]
+
+
+def rendering_cpu_s() -> float:
+    """CPU seconds spent rendering recordings in :func:`ensure_scenario` for this process
+    (``reproduce`` reports them as rendering, apart from the experiments' method time)."""
+    return _RENDERING_CPU_S[0]
+
+
+def add_rendering_cpu(seconds: float) -> None:
+    """Count rendering done for this process elsewhere (a cluster worker's task)."""
+    _RENDERING_CPU_S[0] += seconds
+
+
 def ensure_scenario(
     name_or_path: str | Path,
     folder: Path | None = None,
@@ -262,7 +278,9 @@ def ensure_scenario(
     if say is not None:
         state = "out of date (the scene or the renderer changed)" if path.exists() else "absent"
         say(f"generating {path} ({state}) ...")
+    start = time.process_time()
     synthesize(load_scenario(yaml_path), path, "mcap", seed=seed)
+    add_rendering_cpu(time.process_time() - start)
     return path
 
 

@@ -17,6 +17,7 @@ detection time is a measurement beside the thesis' (other hardware), not a claim
 from __future__ import annotations
 
 import math
+import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -45,7 +46,13 @@ from rgbd_eval.pipeline import (
     track_sequence,
 )
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
-from rgbd_eval.sim.synth import ensure_scenario, is_current, recording_path
+from rgbd_eval.sim.synth import (
+    add_rendering_cpu,
+    ensure_scenario,
+    is_current,
+    recording_path,
+    rendering_cpu_s,
+)
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
@@ -145,14 +152,19 @@ def seeded_recordings(
             for args in missing:
                 render_seeded(*args)
         else:
-            map_ordered(client, render_seeded, missing)
+            # a worker in another process counts its rendering there: count it here too
+            for pid, seconds in map_ordered(client, render_seeded, missing):
+                if pid != os.getpid():
+                    add_rendering_cpu(seconds)
     return out
 
 
-def render_seeded(scenario: Path, folder: Path, seed: int) -> None:
+def render_seeded(scenario: Path, folder: Path, seed: int) -> tuple[int, float]:
     """The scenario file's recording at ``seed`` in ``folder`` (a task of
-    :func:`seeded_recordings`)."""
+    :func:`seeded_recordings`); returns the process id and the CPU seconds it rendered."""
+    before = rendering_cpu_s()
     ensure_scenario(scenario, folder, seed=seed)
+    return os.getpid(), rendering_cpu_s() - before
 
 
 @dataclass(frozen=True)
