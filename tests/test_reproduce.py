@@ -184,7 +184,7 @@ def _seeded(*broken: tuple[int, str]) -> SeededReproduction:
 def test_a_claim_that_flips_between_seeds_is_inconclusive() -> None:
     claims = paper_values()["claims"]
     res = _seeded((2, "table_7_5_mota"), *((s, "main_tr_overall") for s in (1, 2, 3)))
-    by = {v.sentence: v for v in res.verdicts}
+    by = {v.key: v for v in res.verdicts}
     flipping = by[claims["table_7_5_mota"]["sentence"]]
     assert flipping.verdict is Verdict.INCONCLUSIVE
     assert [c.held for c in flipping.per_seed.values()] == [True, False, True]
@@ -194,7 +194,7 @@ def test_a_claim_that_flips_between_seeds_is_inconclusive() -> None:
     held = [
         v
         for k, v in by.items()
-        if k not in {flipping.sentence, claims["main_tr_overall"]["sentence"]}
+        if k not in {flipping.key, claims["main_tr_overall"]["sentence"]}
     ]
     assert len(held) == 10 and all(v.verdict is Verdict.HELD for v in held)
 
@@ -227,7 +227,7 @@ def test_seeds_page_and_json_show_verdicts_spreads_statements_and_time() -> None
     assert data["tables"]["7.2"]["static_simple"]["mota"] == pytest.approx(0.931)
     assert data["tables_spread"]["7.2"]["static_obstacles"]["all_tr"]["min"] == pytest.approx(0.90)
     assert data["detection_time"]["paper_detect_ms"] == [25.0, 29.0]
-    result = ReproduceResult(text, data, tuple((v.sentence, v.verdict) for v in res.verdicts))
+    result = ReproduceResult(text, data, tuple((v.key, v.verdict) for v in res.verdicts))
     page = reproduce_page(result, "basso2012")
     assert "inconclusive" in page and "Table 7.2" in page
 

@@ -78,3 +78,33 @@ def test_over_seeds_judges_a_claim_on_every_seed_or_calls_it_inconclusive() -> N
     assert over_seeds([1, 2], {1: True, 2: None}, {})[0] is Verdict.INCONCLUSIVE
     # Flips: inconclusive.
     assert over_seeds([1, 2], {1: True, 2: False}, {})[0] is Verdict.INCONCLUSIVE
+
+
+def test_claims_over_seeds_groups_each_claim_by_key_in_first_seen_order() -> None:
+    from dataclasses import dataclass, field
+
+    from rgbd_eval.verdicts import claims_over_seeds
+
+    @dataclass(frozen=True)
+    class J:
+        key: str
+        held: bool | None
+        measured: dict[str, float] = field(default_factory=dict)
+
+    per_seed = {
+        1: [J("a", True, {"gain": 2.0}), J("b", False)],
+        # seed 2 lists them the other way round and judges "c" too
+        2: [J("b", False), J("a", True, {"gain": 4.0}), J("c", True)],
+        3: [J("a", False, {"gain": -1.0}), J("b", False), J("c", None)],
+    }
+    got = claims_over_seeds(per_seed, lambda j: j.key)
+    assert [c.key for c in got] == ["a", "b", "c"]
+    a, b, c = got
+    # a: held on 1 and 2, failed on 3 -> inconclusive; gain mean (2 + 4 - 1) / 3 = 5/3
+    assert a.verdict is Verdict.INCONCLUSIVE and a.spreads["gain"].mean == pytest.approx(5 / 3)
+    assert a.judged is per_seed[1][0] and list(a.per_seed) == [1, 2, 3]
+    assert b.verdict is Verdict.FAILED  # failed on every seed
+    # c: absent on seed 1, not judged on 3: inconclusive, never held
+    assert c.verdict is Verdict.INCONCLUSIVE and list(c.per_seed) == [2, 3]
+    with pytest.raises(ValueError, match="at least one seed"):
+        claims_over_seeds({}, lambda j: "x")

@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import enum
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Generic, Protocol, TypeVar
 
 
 class Verdict(enum.Enum):
@@ -90,6 +90,58 @@ def over_seeds(
     names = dict.fromkeys(n for s in seeds for n in measured.get(s, {}))
     spreads = {n: Spread.of([measured.get(s, {}).get(n, math.nan) for s in seeds]) for n in names}
     return verdict, spreads
+
+
+class Judged(Protocol):
+    """One seed's judgement of a claim: held (None: not judged there), and the values it
+    compared, by name."""
+
+    @property
+    def held(self) -> bool | None: ...
+
+    @property
+    def measured(self) -> Mapping[str, float]: ...
+
+
+J = TypeVar("J", bound=Judged)
+
+
+@dataclass(frozen=True)
+class ClaimOverSeeds(Generic[J]):
+    """One claim over the seeds: its verdict, each seed's judgement, the measured spreads."""
+
+    key: str
+    verdict: Verdict
+    per_seed: dict[Any, J]
+    spreads: dict[str, Spread]
+
+    @property
+    def judged(self) -> J:
+        """The first seed's judgement (the claim's sentence and source are every seed's)."""
+        return next(iter(self.per_seed.values()))
+
+
+def claims_over_seeds(
+    per_seed: Mapping[Any, Sequence[J]], key: Callable[[J], str]
+) -> list[ClaimOverSeeds[J]]:
+    """Each claim, told apart by ``key``, over the seeds (in the order they first appear):
+    :func:`over_seeds`, so a claim judged on only some seeds is inconclusive."""
+    if not per_seed:
+        raise ValueError("a verdict needs at least one seed")
+    seeds = list(per_seed)
+    by_key: dict[str, dict[Any, J]] = {}
+    for seed, judgements in per_seed.items():
+        for j in judgements:
+            by_key.setdefault(key(j), {})[seed] = j
+    out = []
+    for k, judged in by_key.items():
+        verdict, spreads = over_seeds(
+            seeds,
+            {s: j.held for s, j in judged.items()},
+            {s: j.measured for s, j in judged.items()},
+        )
+        out.append(ClaimOverSeeds(k, verdict, judged, spreads))
+    return out
 
 
 def spreads_json(

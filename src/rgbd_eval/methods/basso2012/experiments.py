@@ -55,7 +55,14 @@ from rgbd_eval.sim.synth import (
 )
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
+from rgbd_eval.verdicts import (
+    ClaimOverSeeds,
+    Spread,
+    Verdict,
+    claims_over_seeds,
+    spreads_json,
+    tally,
+)
 
 if TYPE_CHECKING:
     from distributed import Client
@@ -893,23 +900,15 @@ def to_json(res: Reproduction) -> dict[str, Any]:
 # ----------------------------------------------------------------------------- over seeds
 
 
-@dataclass(frozen=True)
-class ClaimVerdict:
-    """One claim over the seeds: its verdict, each seed's judgement, the measured spreads."""
+#: One claim of the thesis over the seeds (keyed by its sentence).
+ClaimVerdict = ClaimOverSeeds[Claim]
 
-    sentence: str
-    source: str
-    text: str
-    verdict: Verdict
-    per_seed: dict[int, Claim]
-    spreads: dict[str, Spread]
 
-    def evidence(self) -> str:
-        """Each seed's judgement and evidence, one after the other."""
-        return " | ".join(
-            f"seed {s}: {'held' if c.held else 'failed'}: {c.evidence}"
-            for s, c in self.per_seed.items()
-        )
+def evidence(v: ClaimVerdict) -> str:
+    """Each seed's judgement and evidence, one after the other."""
+    return " | ".join(
+        f"seed {s}: {'held' if c.held else 'failed'}: {c.evidence}" for s, c in v.per_seed.items()
+    )
 
 
 @dataclass
@@ -923,24 +922,11 @@ class SeededReproduction:
 
 def verdicts(runs: Mapping[int, Reproduction]) -> list[ClaimVerdict]:
     """Each claim over the seeds: held on every one, failed on every one, else inconclusive,
-    also when it was not judged on some seed (:func:`rgbd_eval.verdicts.over_seeds`), with
-    its measured spreads."""
+    also when it was not judged on some seed (:func:`rgbd_eval.verdicts.claims_over_seeds`),
+    with its measured spreads."""
     if not runs:
         raise ValueError("a verdict needs at least one seed's run")
-    judged: dict[str, dict[int, Claim]] = {}
-    for seed, run in runs.items():
-        for c in run.claims:
-            judged.setdefault(c.sentence, {})[seed] = c
-    out = []
-    for sentence, per_seed in judged.items():
-        first = next(iter(per_seed.values()))
-        verdict, spreads = over_seeds(
-            list(runs),
-            {s: c.held for s, c in per_seed.items()},
-            {s: c.measured for s, c in per_seed.items()},
-        )
-        out.append(ClaimVerdict(sentence, first.source, first.text, verdict, per_seed, spreads))
-    return out
+    return claims_over_seeds({s: r.claims for s, r in runs.items()}, lambda c: c.sentence)
 
 
 def reproduce_seeds(
@@ -1050,11 +1036,12 @@ def render_seeds_markdown(res: SeededReproduction, paper: Mapping[str, Any]) -> 
         measured = "; ".join(f"{n}: {sp.text('.1f')}" for n, sp in v.spreads.items()) or "-"
         held = ", ".join(str(s) for s, c in v.per_seed.items() if c.held) or "none"
         out.append(
-            f'| {v.source} | "{v.sentence}" (tested as {v.text}) | **{v.verdict.value}** | '
+            f'| {v.judged.source} | "{v.key}" (tested as {v.judged.text}) | '
+            f"**{v.verdict.value}** | "
             f"{measured} | {held} |"
         )
     claims = paper["claims"]
-    by_sentence = {v.sentence: v for v in res.verdicts}
+    by_sentence = {v.key: v for v in res.verdicts}
     out += [
         "",
         "## Published statements without a table row",
@@ -1139,13 +1126,13 @@ def seeds_json(res: SeededReproduction, paper: Mapping[str, Any]) -> dict[str, A
         "per_seed": {str(s): to_json(run) for s, run in res.runs.items()},
         "claims": [
             {
-                "text": v.sentence,
-                "tested_as": v.text,
-                "source": v.source,
+                "text": v.key,
+                "tested_as": v.judged.text,
+                "source": v.judged.source,
                 "verdict": v.verdict.value,
                 "held": v.verdict is Verdict.HELD,
                 "per_seed": {str(s): c.held for s, c in v.per_seed.items()},
-                "evidence": v.evidence(),
+                "evidence": evidence(v),
                 "measured": spreads_json(v.spreads, {s: c.measured for s, c in v.per_seed.items()}),
             }
             for v in res.verdicts
@@ -1168,5 +1155,5 @@ def reproduce(recordings: Mapping[str, Path], options: ReproduceOptions) -> Repr
     return ReproduceResult(
         markdown=render_seeds_markdown(res, paper),
         data=seeds_json(res, paper),
-        claims=tuple((v.sentence, v.verdict) for v in res.verdicts),
+        claims=tuple((v.key, v.verdict) for v in res.verdicts),
     )

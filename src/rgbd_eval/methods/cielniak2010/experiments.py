@@ -41,7 +41,14 @@ from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.types import Box2D
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
+from rgbd_eval.verdicts import (
+    ClaimOverSeeds,
+    Spread,
+    Verdict,
+    claims_over_seeds,
+    spreads_json,
+    tally,
+)
 
 #: The summary measures shown per ablation variant.
 MEASURES = ("mota", "motp", "idf1", "id_switches", "fn_rate", "fp_rate")
@@ -293,36 +300,15 @@ def check_claims(
     return out
 
 
-@dataclass(frozen=True)
-class ClaimVerdict:
-    """One claim over the seeds: its verdict, each seed's judgement, the measured spreads."""
-
-    key: str
-    source: str
-    sentence: str
-    verdict: Verdict
-    per_seed: dict[int, Judgement]
-    spreads: dict[str, Spread]
+#: One claim of the paper over the seeds.
+ClaimVerdict = ClaimOverSeeds[Judgement]
 
 
 def verdicts(per_seed: Mapping[int, Sequence[Judgement]]) -> list[ClaimVerdict]:
     """Each claim over the seeds: held on every seed, failed on every seed, else
-    inconclusive; a claim not judged on some seed (a variant could not run) is inconclusive."""
-    if not per_seed:
-        raise ValueError("a verdict needs at least one seed")
-    seeds = list(per_seed)
-    out = []
-    for i, first in enumerate(per_seed[seeds[0]]):
-        judged = {s: per_seed[s][i] for s in seeds}
-        if any(j.key != first.key for j in judged.values()):
-            raise ValueError(f"claim {i} differs between seeds")
-        verdict, spreads = over_seeds(
-            seeds,
-            {s: j.held for s, j in judged.items()},
-            {s: j.measured for s, j in judged.items()},
-        )
-        out.append(ClaimVerdict(first.key, first.source, first.sentence, verdict, judged, spreads))
-    return out
+    inconclusive; a claim not judged on some seed (a variant could not run) is inconclusive
+    (:func:`rgbd_eval.verdicts.claims_over_seeds`)."""
+    return claims_over_seeds(per_seed, lambda j: j.key)
 
 
 @dataclass
@@ -462,8 +448,8 @@ def summarise(
         "claims": [
             {
                 "key": c.key,
-                "text": c.sentence,
-                "source": c.source,
+                "text": c.judged.sentence,
+                "source": c.judged.source,
                 "verdict": c.verdict.value,
                 "held": c.verdict is Verdict.HELD,
                 "per_seed": {str(s): j.held for s, j in c.per_seed.items()},
@@ -477,7 +463,7 @@ def summarise(
     return ReproduceResult(
         markdown=render(paper, data, runs, judged),
         data=data,
-        claims=tuple((c.sentence, c.verdict) for c in judged),
+        claims=tuple((c.judged.sentence, c.verdict) for c in judged),
     )
 
 
@@ -552,7 +538,10 @@ def render(
     for c in judged:
         measured = "; ".join(f"{n}: {sp.text('.1f')}" for n, sp in c.spreads.items()) or "-"
         held = ", ".join(str(s) for s, j in c.per_seed.items() if j.held) or "none"
-        out.append(f'| "{c.sentence}" ({c.source}) | **{c.verdict.value}** | {measured} | {held} |')
+        out.append(
+            f'| "{c.judged.sentence}" ({c.judged.source}) | **{c.verdict.value}** | {measured} '
+            f"| {held} |"
+        )
     out += [
         "",
         "### Occluded person instances (section 7)",

@@ -44,7 +44,14 @@ from rgbd_eval.sim.rig_config import StaticDepthConfig
 from rgbd_eval.sim.scenario import Obstacle, Scenario, load_scenario
 from rgbd_eval.sim.tof import TofFrame, TofRig
 from rgbd_eval.types import GroundTruthObject, Pose, TrackOutput
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
+from rgbd_eval.verdicts import (
+    ClaimOverSeeds,
+    Spread,
+    Verdict,
+    claims_over_seeds,
+    spreads_json,
+    tally,
+)
 
 #: Metric gating distance (m). The seed matches within a threshold distance whose value did
 #: not survive in its text; 0.5 m (methods/dmtbs/method.yaml states why).
@@ -838,35 +845,15 @@ def aggregate(
     return out
 
 
-@dataclass(frozen=True)
-class ClaimVerdict:
-    """One claim over the seeds: its verdict, each seed's judgement, the measured spreads."""
-
-    key: str
-    sentence: str
-    verdict: Verdict
-    per_seed: dict[int, Judgement]
-    spreads: dict[str, Spread]
+#: One claim of the paper over the seeds.
+ClaimVerdict = ClaimOverSeeds[Judgement]
 
 
 def verdicts(per_seed: Mapping[int, Sequence[Judgement]]) -> list[ClaimVerdict]:
     """Each claim over the seeds: held on every seed, failed on every seed, else
-    inconclusive (:func:`rgbd_eval.verdicts.over_runs`), with each measured value's spread."""
-    if not per_seed:
-        raise ValueError("a verdict needs at least one seed")
-    seeds = list(per_seed)
-    out = []
-    for i, first in enumerate(per_seed[seeds[0]]):
-        judged = {s: per_seed[s][i] for s in seeds}
-        if any(j.key != first.key for j in judged.values()):
-            raise ValueError(f"claim {i} differs between seeds")
-        verdict, spreads = over_seeds(
-            seeds,
-            {s: j.held for s, j in judged.items()},
-            {s: j.measured for s, j in judged.items()},
-        )
-        out.append(ClaimVerdict(first.key, first.sentence, verdict, judged, spreads))
-    return out
+    inconclusive (:func:`rgbd_eval.verdicts.claims_over_seeds`), with each measured value's
+    spread."""
+    return claims_over_seeds(per_seed, lambda j: j.key)
 
 
 def summarise(paper: Mapping[str, Any], runs: Mapping[int, SeedRun]) -> ReproduceResult:
@@ -907,7 +894,7 @@ def summarise(paper: Mapping[str, Any], runs: Mapping[int, SeedRun]) -> Reproduc
         "claims": [
             {
                 "key": c.key,
-                "text": c.sentence,
+                "text": c.judged.sentence,
                 "verdict": c.verdict.value,
                 "held": c.verdict is Verdict.HELD,
                 "per_seed": {str(s): j.held for s, j in c.per_seed.items()},
@@ -919,7 +906,7 @@ def summarise(paper: Mapping[str, Any], runs: Mapping[int, SeedRun]) -> Reproduc
     return ReproduceResult(
         render_markdown(data, runs, judged),
         data,
-        tuple((c.sentence, c.verdict) for c in judged),
+        tuple((c.judged.sentence, c.verdict) for c in judged),
     )
 
 
@@ -989,7 +976,7 @@ def render_markdown(
     for c in judged:
         measured = "; ".join(f"{name}: {sp.text('.1f')}" for name, sp in c.spreads.items())
         held = ", ".join(str(s) for s, j in c.per_seed.items() if j.held) or "none"
-        lines.append(f"| {c.sentence} | **{c.verdict.value}** | {measured} | {held} |")
+        lines.append(f"| {c.judged.sentence} | **{c.verdict.value}** | {measured} | {held} |")
     lines += [
         "",
         "## Fig. 8: camera angle (scene 1, one camera)",

@@ -39,7 +39,14 @@ from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
 from rgbd_eval.sim.synth import ensure_scenario
 from rgbd_eval.sweep import point_configs, run_sweep
-from rgbd_eval.verdicts import Spread, Verdict, over_seeds, spreads_json, tally
+from rgbd_eval.verdicts import (
+    ClaimOverSeeds,
+    Spread,
+    Verdict,
+    claims_over_seeds,
+    spreads_json,
+    tally,
+)
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
@@ -423,38 +430,15 @@ def measure(
     return tables
 
 
-@dataclass(frozen=True)
-class ClaimVerdict:
-    """One claim over the seeds: its verdict, each seed's judgement, the measured spreads."""
-
-    key: str
-    source: str
-    text: str
-    verdict: Verdict
-    per_seed: dict[int, Claim]
-    spreads: dict[str, Spread]
+#: One claim of the paper over the seeds.
+ClaimVerdict = ClaimOverSeeds[Claim]
 
 
 def verdicts(per_seed: Mapping[int, Sequence[Claim]]) -> list[ClaimVerdict]:
-    """Each claim over the seeds (:func:`rgbd_eval.verdicts.over_seeds`), with the spread of
-    each value it measured. A claim judged on only some seeds (its row missing on others) is
-    inconclusive."""
-    if not per_seed:
-        raise ValueError("a verdict needs at least one seed")
-    keys: list[str] = []
-    for claims in per_seed.values():
-        keys += [c.key for c in claims if c.key not in keys]
-    out = []
-    for key in keys:
-        judged = {s: c for s, claims in per_seed.items() for c in claims if c.key == key}
-        first = next(iter(judged.values()))
-        verdict, spreads = over_seeds(
-            list(per_seed),
-            {s: c.held for s, c in judged.items()},
-            {s: c.measured for s, c in judged.items()},
-        )
-        out.append(ClaimVerdict(key, first.source, first.text, verdict, judged, spreads))
-    return out
+    """Each claim over the seeds (:func:`rgbd_eval.verdicts.claims_over_seeds`), with the
+    spread of each value it measured. A claim judged on only some seeds (its row missing on
+    others) is inconclusive."""
+    return claims_over_seeds(per_seed, lambda c: c.key)
 
 
 def mean_tables(per_seed: Sequence[Mapping[str, Mapping[str, Any]]]) -> dict[str, Any]:
@@ -522,8 +506,8 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
         "claims": [
             {
                 "key": c.key,
-                "text": c.text,
-                "source": c.source,
+                "text": c.judged.text,
+                "source": c.judged.source,
                 "verdict": c.verdict.value,
                 "held": c.verdict is Verdict.HELD,
                 "per_seed": {str(s): j.held for s, j in c.per_seed.items()},
@@ -541,7 +525,7 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
     return ReproduceResult(
         markdown=render(per_seed, over, paper, timing),
         data=data,
-        claims=tuple((c.text, c.verdict) for c in over),
+        claims=tuple((c.judged.text, c.verdict) for c in over),
     )
 
 
@@ -615,7 +599,10 @@ def render(
     ]
     for c in claims:
         per = ", ".join(f"{s}: {'held' if j.held else 'failed'}" for s, j in c.per_seed.items())
-        out.append(f'| {c.source}: "{c.text}" | {c.verdict.value} | {_spreads(c) or "-"} | {per} |')
+        out.append(
+            f'| {c.judged.source}: "{c.judged.text}" | {c.verdict.value} | '
+            f"{_spreads(c) or '-'} | {per} |"
+        )
     out += ["", f"claims: {tally([c.verdict for c in claims])}", ""]
     for c in claims:
         out.append(f"- {c.key} ({c.verdict.value}):")
