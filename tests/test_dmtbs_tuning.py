@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -12,6 +10,7 @@ import yaml
 
 from rgbd_eval.methods.dmtbs.detector import DmtbsDetectorConfig
 from rgbd_eval.sim.scenario import load_scenario, scenarios_dir
+from tests.tools import load_tool
 
 ROOT = Path(__file__).resolve().parents[1]
 TUNING = scenarios_dir() / "tuning" / "dmtbs_hall_tuning.yaml"
@@ -19,13 +18,7 @@ SCORED = scenarios_dir() / "dmtbs"
 
 
 def _tool() -> ModuleType:
-    path = ROOT / "tools" / "dmtbs" / "min_blob_area.py"
-    spec = importlib.util.spec_from_file_location("dmtbs_min_blob_area", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("tools/dmtbs/min_blob_area.py", "dmtbs_min_blob_area")
 
 
 TOOL = _tool()

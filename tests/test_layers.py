@@ -8,10 +8,10 @@ module places it; the order is the layer order, lowest first).
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from types import ModuleType
+
+from tests.tools import load_tool
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -103,14 +103,7 @@ LAYERS = [
 
 
 def _tool() -> ModuleType:
-    spec = importlib.util.spec_from_file_location(
-        "import_graph", ROOT / "tools" / "import_graph.py"
-    )
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module  # dataclasses look their module up
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("tools/import_graph.py", "import_graph")
 
 
 TOOL = _tool()

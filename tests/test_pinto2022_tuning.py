@@ -2,28 +2,20 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from types import ModuleType
 
 import pytest
 
 from rgbd_eval.sim.scenario import load_scenario, scenarios_dir
+from tests.tools import load_tool
 
-ROOT = Path(__file__).resolve().parents[1]
 TUNING = sorted((scenarios_dir() / "tuning").glob("pinto2022_*_tuning.yaml"))
 SCORED = sorted((scenarios_dir() / "pinto2022").glob("*.yaml"))
 
 
 def _tool() -> ModuleType:
-    path = ROOT / "tools" / "pinto2022" / "calibrate_reid.py"
-    spec = importlib.util.spec_from_file_location("pinto2022_calibrate_reid", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("tools/pinto2022/calibrate_reid.py", "pinto2022_calibrate_reid")
 
 
 def test_the_tuning_scenes_differ_from_the_scored_scenes() -> None:

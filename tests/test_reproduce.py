@@ -192,9 +192,7 @@ def test_a_claim_that_flips_between_seeds_is_inconclusive() -> None:
     assert (gain.low, gain.high, gain.runs) == (pytest.approx(2.0), pytest.approx(16.3), 3)
     assert by[claims["main_tr_overall"]["sentence"]].verdict is Verdict.FAILED
     held = [
-        v
-        for k, v in by.items()
-        if k not in {flipping.key, claims["main_tr_overall"]["sentence"]}
+        v for k, v in by.items() if k not in {flipping.key, claims["main_tr_overall"]["sentence"]}
     ]
     assert len(held) == 10 and all(v.verdict is Verdict.HELD for v in held)
 

