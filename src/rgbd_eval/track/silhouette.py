@@ -149,7 +149,9 @@ def _sample(image: NDArray[np.float32], x: F64, y: F64) -> tuple[F64, NDArray[np
     xi = np.rint(x).astype(np.intp)
     yi = np.rint(y).astype(np.intp)
     ok = (xi >= 0) & (xi < W) & (yi >= 0) & (yi < H)
-    vals: F64 = image[np.clip(yi, 0, H - 1), np.clip(xi, 0, W - 1)].astype(np.float64)
+    # one flat index (the clipped pixel of a point outside is read and not used)
+    flat = np.minimum(np.maximum(yi, 0), H - 1) * W + np.minimum(np.maximum(xi, 0), W - 1)
+    vals: F64 = np.ravel(image).take(flat).astype(np.float64)
     return vals, ok
 
 
