@@ -161,10 +161,11 @@ class IntegralMoments:
     def moments_many(self, boxes: NDArray[np.intp]) -> F64:
         """``(N, 3, C)``: :meth:`moments` of N integer boxes (N, 4) at once."""
         H, W = self.shape
-        u0 = np.clip(boxes[:, 0], 0, W)
-        u1 = np.clip(boxes[:, 2], 0, W)
-        v0 = np.clip(boxes[:, 1], 0, H)
-        v1 = np.clip(boxes[:, 3], 0, H)
+        # integer clips by minimum/maximum (np.clip's Python wrapper costs more than them)
+        u0 = np.minimum(np.maximum(boxes[:, 0], 0), W)
+        u1 = np.minimum(np.maximum(boxes[:, 2], 0), W)
+        v0 = np.minimum(np.maximum(boxes[:, 1], 0), H)
+        v1 = np.minimum(np.maximum(boxes[:, 3], 0), H)
         # the four corners as flat indices, computed once for every integral image
         corners = [v * (W + 1) + u for v, u in ((v1, u1), (v0, u1), (v1, u0), (v0, u0))]
 
