@@ -38,7 +38,8 @@ REGIONS: tuple[tuple[float, float, float], ...] = (
 
 
 #: The cubes of the 8-bit values, exact in float32 (255^3 < 2^24).
-_CUBES = (np.arange(256, dtype=np.float32) ** 3).astype(np.float32)
+_VALUES = np.arange(256, dtype=np.float32)
+_CUBES = _VALUES * _VALUES * _VALUES
 _NONE: F64 = np.zeros((0, 0, 0))
 
 
