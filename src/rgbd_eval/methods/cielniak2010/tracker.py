@@ -444,18 +444,12 @@ class Cielniak2010Tracker:
         neither penalises nor is penalised by the others; its occluder tracks as usual."""
         H, W = temp.shape
         behind = self._occluded(temp, colour)
-        kept = []
+        stepped = []
         for i, t in enumerate(self.tracks):
             if i in behind:
                 t.filter.predict(dt)
                 t.filter.estimate = t.filter.particles.mean(axis=0)
                 t.occluded_frames += 1
-                est = t.filter.estimate
-                inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
-                if inside and t.occluded_frames <= self.cfg.max_occluded_frames:
-                    kept.append(t)
-                else:
-                    self._forget(t)
                 continue
             t.occluded_frames = 0
             others: list[Neighbour] = [
@@ -466,15 +460,24 @@ class Cielniak2010Tracker:
             t.filter.step(
                 functools.partial(self._loglik, temp, thermal, model=t.colour), dt, others
             )
-            est = t.filter.estimate
-            t.score = float(
-                silhouette_scores(
-                    temp, self.silhouette, est[None, :], self.contrast, self.surround_room
-                )[0]
+            stepped.append(t)
+        if stepped:  # the estimates' scores in one call (each row is computed on its own)
+            estimates = np.stack([t.filter.estimate for t in stepped])
+            scores = silhouette_scores(
+                temp, self.silhouette, estimates, self.contrast, self.surround_room
             )
-            t.weak_frames = t.weak_frames + 1 if t.score < self.cfg.stop_score else 0
+            for t, score in zip(stepped, scores, strict=True):
+                t.score = float(score)
+        kept = []
+        for i, t in enumerate(self.tracks):
+            est = t.filter.estimate
             inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
-            if inside and t.weak_frames < self.cfg.lost_frames:
+            if i in behind:
+                alive = inside and t.occluded_frames <= self.cfg.max_occluded_frames
+            else:
+                t.weak_frames = t.weak_frames + 1 if t.score < self.cfg.stop_score else 0
+                alive = inside and t.weak_frames < self.cfg.lost_frames
+            if alive:
                 kept.append(t)
             else:
                 self._forget(t)
@@ -492,12 +495,18 @@ class Cielniak2010Tracker:
         if self.integral is None:
             return
         boxes = [t.filter.box() for t in self.tracks]
-        for i, t in enumerate(self.tracks):
-            if t.occluded_frames or t.score < self.cfg.start_score:
-                continue
-            if any(overlap(boxes[i], b) > 0.0 for j, b in enumerate(boxes) if j != i):
-                continue
-            seen = self._observe(t.filter.estimate[None, :])[0]
+        clear = [
+            t
+            for i, t in enumerate(self.tracks)
+            if not t.occluded_frames
+            and t.score >= self.cfg.start_score
+            and not any(overlap(boxes[i], b) > 0.0 for j, b in enumerate(boxes) if j != i)
+        ]
+        if not clear:
+            return
+        # the moments of all their estimates in one call (each row is computed on its own)
+        observed = self._observe(np.stack([t.filter.estimate for t in clear]))
+        for t, seen in zip(clear, observed, strict=True):
             t.colour = (
                 ColourModel(seen)
                 if t.colour is None
