@@ -9,6 +9,7 @@ from rgbd_eval.track.colour_moments import (
     ColourModel,
     IntegralMoments,
     MomentWeights,
+    channel_means,
     moment_distance,
     moment_distances,
     noise_sigma,
@@ -185,7 +186,40 @@ def test_eight_bit_and_float_integrals_are_the_same_numbers() -> None:
     rng = np.random.default_rng(3)
     image = rng.integers(0, 256, (30, 40, 3)).astype(np.uint8)
     mask = rng.random((30, 40)) < 0.5
-    for m in (None, mask):
-        a, b = IntegralMoments.of(image, m), IntegralMoments.of(image.astype(np.float64), m)
-        for x, y in ((a.s1, b.s1), (a.s2, b.s2), (a.s3, b.s3)):
+    for img in (image, image[..., 1]):
+        for m in (None, mask):
+            a, b = IntegralMoments.of(img, m), IntegralMoments.of(img.astype(np.float64), m)
+            for x, y in ((a.s1, b.s1), (a.s2, b.s2), (a.s3, b.s3)):
+                np.testing.assert_array_equal(x, y)
+
+
+def test_reused_integrals_are_overwritten_with_the_same_numbers() -> None:
+    # a tracker passes last frame's integrals to be written into: equal to fresh ones
+    rng = np.random.default_rng(4)
+    frames = [rng.integers(0, 256, (30, 40, 3)).astype(np.uint8) for _ in range(3)]
+    masks = [rng.random((30, 40)) < 0.4 for _ in range(3)]
+    last = None
+    for image, mask in zip(frames, masks, strict=True):
+        fresh = IntegralMoments.of(image, mask, 4)
+        last = IntegralMoments.of(image, mask, 4, reuse=last)
+        assert last.count is not None and fresh.count is not None
+        for x, y in ((last.s1, fresh.s1), (last.s2, fresh.s2), (last.s3, fresh.s3)):
             np.testing.assert_array_equal(x, y)
+        np.testing.assert_array_equal(last.count, fresh.count)
+    # another shape: new arrays
+    other = IntegralMoments.of(frames[0][:20], masks[0][:20], 4, reuse=last)
+    assert other.s1.shape == (21, 41, 3)
+    np.testing.assert_array_equal(other.s3, IntegralMoments.of(frames[0][:20], masks[0][:20]).s3)
+
+
+def test_eight_bit_noise_and_means_are_the_float_numbers() -> None:
+    # the 8-bit paths (int16 filter, OpenCV sums) give the float paths' numbers exactly
+    rng = np.random.default_rng(5)
+    for shape in ((48, 64, 3), (48, 64), (5, 7, 1)):
+        image = rng.integers(0, 256, shape).astype(np.uint8)
+        assert noise_sigma(image) == noise_sigma(image.astype(np.float32))
+    image = rng.integers(0, 256, (48, 64, 3)).astype(np.uint8)
+    np.testing.assert_array_equal(channel_means(image), image.reshape(-1, 3).mean(axis=0))
+    np.testing.assert_array_equal(
+        channel_means(image[::2, ::2]), image[::2, ::2].reshape(-1, 3).mean(axis=0)
+    )

@@ -9,7 +9,7 @@ from scipy import ndimage
 from rgbd_eval.sim import Simulator, parse_scenario
 from rgbd_eval.sim.rig_config import ThermalCameraConfig
 from rgbd_eval.sim.thermal_camera import ThermalCamera, counts_to_celsius
-from rgbd_eval.track.silhouette import Silhouette, silhouette_scores
+from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores
 from rgbd_eval.track.thermal_pf import (
     F64,
     FilterParams,
@@ -119,6 +119,28 @@ def _blob_image(people: list[tuple[float, float, float, float]]) -> np.ndarray:
             inside |= ((xx - u) / (a * h)) ** 2 + ((yy - (v + cy * h)) / (b * h)) ** 2 <= 1
         img[inside] = t
     return ndimage.gaussian_filter(img, 0.7)
+
+
+def test_each_state_scores_the_same_bits_alone_and_among_others() -> None:
+    # the cielniak2010 tracker scores all its filters' estimates in one call
+    rng = np.random.default_rng(8)
+    params = ContrastParams(0.05, saturation=8.0, surround=0.15, surround_weight=1.0)
+    temp = (20.0 + 15.0 * rng.random((120, 160))).astype(np.float32)
+    n = 7
+    states = np.column_stack(
+        [
+            rng.uniform(-10, 170, n),
+            rng.uniform(-10, 130, n),
+            rng.uniform(20, 150, n),
+            np.zeros((n, 2)),
+            rng.uniform(0.55, 1.1, n),
+        ]
+    )
+    together = silhouette_scores(temp, SIL, states, params, room=21.0)
+    alone = [
+        silhouette_scores(temp, SIL, states[k : k + 1], params, room=21.0)[0] for k in range(n)
+    ]
+    np.testing.assert_array_equal(together, np.array(alone))
 
 
 def test_filter_locks_on_from_a_uniform_start_and_is_bit_identical_per_seed() -> None:

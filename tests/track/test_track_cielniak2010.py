@@ -7,6 +7,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from scipy import ndimage
 
 from rgbd_eval.config import build_config
 from rgbd_eval.methods.cielniak2010.occlusion import order, overlap, sort_front_to_back
@@ -19,8 +20,15 @@ from rgbd_eval.methods.cielniak2010.tracker import (
     Affine,
     Cielniak2010Tracker,
     Cielniak2010TrackerConfig,
+    _every_kth_pixel,
+    median_temperature,
+    temperature_image,
 )
-from rgbd_eval.methods.cielniak2010.warm_regions import WarmRegionParams, warm_regions
+from rgbd_eval.methods.cielniak2010.warm_regions import (
+    WarmRegionParams,
+    _dilated,
+    warm_regions,
+)
 from rgbd_eval.plugins import DetectionContract
 from rgbd_eval.types import CameraModel, Frame, Pose, Stream
 
@@ -102,6 +110,34 @@ def test_warm_regions_keep_person_shaped_components() -> None:
     # the second person loses the 2 px next to the radiator: columns 112..119
     assert people == {(10, 10, 30, 70), (112, 20, 120, 50)}
     assert (40, 80, 80, 100) in {tuple(int(x) for x in b) for b in regions.boxes}
+
+
+def test_fast_median_and_subsampling_are_numpys() -> None:
+    # the histogram median of the counts and OpenCV's subsampling give numpy's numbers
+    rng = np.random.default_rng(7)
+    for shape, encoding, dtype in (
+        ((24, 32), "mono16", np.uint16),
+        ((25, 31), "mono16", np.uint16),
+        ((24, 32), "mono8", np.uint8),
+    ):
+        counts = rng.integers(29000 if dtype == np.uint16 else 0, 31000, shape).astype(dtype)
+        stream = Stream(counts, encoding, THERMAL, 0)
+        temp = temperature_image(stream)
+        assert median_temperature(stream, temp) == float(np.median(temp))
+    image = rng.integers(0, 256, (48, 64, 3)).astype(np.uint8)
+    for k in (1, 2, 3, 4, 16):
+        np.testing.assert_array_equal(_every_kth_pixel(image, k), image[::k, ::k])
+    np.testing.assert_array_equal(_every_kth_pixel(image[:47], 2), image[:47:2, ::2])
+
+
+def test_hot_margin_is_scipys_binary_dilation() -> None:
+    # OpenCV's dilation grows the hot pixels as ndimage's 8-connected one, up to the border
+    rng = np.random.default_rng(6)
+    for iterations in (1, 2, 3):
+        hot = rng.random((40, 50)) < 0.02
+        hot[0, 7] = hot[39, 49] = True
+        expected = ndimage.binary_dilation(hot, np.ones((3, 3), bool), iterations=iterations)
+        np.testing.assert_array_equal(_dilated(hot, iterations), expected)
 
 
 def test_implied_height_of_a_person_on_the_floor_hand_computed() -> None:

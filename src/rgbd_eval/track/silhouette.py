@@ -103,12 +103,14 @@ def silhouette_scores(
     silhouette: Silhouette,
     states: F64,
     params: ContrastParams = ContrastParams(),
+    room: float | None = None,
 ) -> F64:
     """Mean inward-minus-outward temperature (K) along the contour of each state ``(u, v, h, ...)``.
 
     A sixth column, when present, is the width factor ``a`` (the silhouette's widths are
     scaled by it: about 1 for a person seen from the front, 0.6-0.7 in profile). A contour
     point whose inner or outer sample falls outside the image scores 0 (nothing is measured).
+    ``room``: :func:`room_temperature` of ``temperature`` when the caller has it already.
     """
     if states.ndim != 2 or states.shape[1] < 3:
         raise ValueError(f"states shape {states.shape} must be (N, >=3)")
@@ -125,7 +127,8 @@ def silhouette_scores(
     point = np.where(ok_in & ok_out, np.clip(t_in - t_out, 0.0, params.saturation), 0.0)
     out: F64 = point.mean(axis=1).astype(np.float64)
     if params.surround_weight > 0.0:
-        room = float(np.median(temperature[::4, ::4]))
+        if room is None:
+            room = room_temperature(temperature)
         ds = params.surround * h
         t_far, ok_far = _sample(
             temperature, x + silhouette.normals[:, 0] * ds, y + silhouette.normals[:, 1] * ds
@@ -135,13 +138,20 @@ def silhouette_scores(
     return out
 
 
+def room_temperature(temperature: NDArray[np.float32]) -> float:
+    """The room's temperature for the surround term: the median of every 4th pixel."""
+    return float(np.median(temperature[::4, ::4]))
+
+
 def _sample(image: NDArray[np.float32], x: F64, y: F64) -> tuple[F64, NDArray[np.bool_]]:
     """Nearest-pixel values at ``(x, y)`` and whether each lies inside the image."""
     H, W = image.shape
     xi = np.rint(x).astype(np.intp)
     yi = np.rint(y).astype(np.intp)
     ok = (xi >= 0) & (xi < W) & (yi >= 0) & (yi < H)
-    vals: F64 = image[np.clip(yi, 0, H - 1), np.clip(xi, 0, W - 1)].astype(np.float64)
+    # one flat index (the clipped pixel of a point outside is read and not used)
+    flat = np.minimum(np.maximum(yi, 0), H - 1) * W + np.minimum(np.maximum(xi, 0), W - 1)
+    vals: F64 = np.ravel(image).take(flat).astype(np.float64)
     return vals, ok
 
 

@@ -63,17 +63,29 @@ from rgbd_eval.methods.cielniak2010.person_geometry import (
     height_log_prior,
     implied_heights,
 )
-from rgbd_eval.methods.cielniak2010.warm_regions import WarmRegionParams, WarmRegions, warm_regions
+from rgbd_eval.methods.cielniak2010.warm_regions import (
+    WarmRegionParams,
+    WarmRegions,
+    room_median,
+    warm_regions,
+)
 from rgbd_eval.plugins import DetectionContract, StreamSpec, TrackerSpec, register_tracker
 from rgbd_eval.track.colour_moments import (
     ColourModel,
     IntegralMoments,
+    channel_means,
     moment_distances,
     noise_sigma,
     person_moments_many,
     reliability,
 )
-from rgbd_eval.track.silhouette import ContrastParams, Silhouette, silhouette_scores, state_boxes
+from rgbd_eval.track.silhouette import (
+    ContrastParams,
+    Silhouette,
+    room_temperature,
+    silhouette_scores,
+    state_boxes,
+)
 from rgbd_eval.track.thermal_pf import (
     F64,
     FilterParams,
@@ -225,10 +237,45 @@ class _Proposal:
 
 def temperature_image(stream: Stream) -> np.ndarray:
     """Thermal counts as temperature: mono16 centikelvin to deg C; mono8 kept as counts."""
-    img = stream.image.astype(np.float32)
-    if stream.encoding == "mono16":
-        return img / np.float32(100.0) - np.float32(_ZERO_C_K)
+    return _temperatures(stream.image, stream.encoding)
+
+
+def _temperatures(counts: np.ndarray, encoding: str) -> NDArray[np.float32]:
+    img = counts.astype(np.float32)
+    if encoding == "mono16":
+        out: NDArray[np.float32] = img / np.float32(100.0) - np.float32(_ZERO_C_K)
+        return out
     return img
+
+
+def median_temperature(stream: Stream, temp: NDArray[np.float32]) -> float:
+    """``float(np.median(temp))`` of ``temp = temperature_image(stream)``, the same number.
+
+    Integer counts (mono8, mono16) by a histogram, several times faster than sorting: the
+    map from counts to temperatures does not decrease, so the middle counts map to the
+    middle temperatures, and ``np.median`` of those two takes their mean as it would.
+    """
+    counts = stream.image
+    if counts.dtype not in (np.uint8, np.uint16) or counts.size == 0:
+        return room_median(temp)
+    flat = counts.ravel()
+    low = int(flat.min())
+    cumulative = np.cumsum(np.bincount(flat - np.asarray(low, dtype=flat.dtype)))
+    n = flat.size
+    ranks = np.array(sorted({(n - 1) // 2, n // 2}))
+    middle = np.searchsorted(cumulative, ranks, side="right") + low
+    return room_median(_temperatures(middle.astype(counts.dtype), stream.encoding))
+
+
+def _every_kth_pixel(image: NDArray[np.uint8], k: int) -> NDArray[np.uint8]:
+    """``image[::k, ::k]``, contiguous. By OpenCV's nearest-pixel resize where that picks the
+    same pixels (``k`` a power of two dividing both sides: its source column ``floor(x *
+    k)`` is then exact), three times faster than numpy's strided copy."""
+    h, w = image.shape[:2]
+    if k > 1 and k & (k - 1) == 0 and h % k == 0 and w % k == 0 and image.dtype == np.uint8:
+        out = cv2.resize(image, (w // k, h // k), interpolation=cv2.INTER_NEAREST)
+        return np.asarray(out, dtype=np.uint8).reshape(h // k, w // k, *image.shape[2:])
+    return np.ascontiguousarray(image[::k, ::k])
 
 
 def _state_of_box(box: F64, width_ratio: float, aspect: tuple[float, float]) -> F64:
@@ -270,6 +317,7 @@ class Cielniak2010Tracker:
         self.frame_index = 0
         self.integral: IntegralMoments | None = None
         self.noise = 0.0
+        self.surround_room = 0.0
         self.background: F64 = np.zeros(3)
         self.next_id = 1
         self.last_stamp: int | None = None
@@ -284,26 +332,30 @@ class Cielniak2010Tracker:
         t0 = time.perf_counter()
         thermal = frame.stream("thermal")
         temp = temperature_image(thermal)
+        room = median_temperature(thermal, temp)
+        self.surround_room = room_temperature(temp)
         colour = frame.streams.get("colour")
         if colour is not None and self.affine is None:
             self.affine = Affine.between(thermal, colour, self.cfg.alignment_depth_m)
-        self.integral = None
+        previous, self.integral = self.integral, None
         if self.cfg.colour and colour is not None and colour.image.ndim == 3:
             k = self.cfg.colour_stride
-            image = np.ascontiguousarray(colour.image[::k, ::k])
+            image = _every_kth_pixel(colour.image, k)
             mask = None
             if self.cfg.colour_mask and self.affine is not None:
-                mask = self.affine.warp(self._warm_mask(temp), image.shape[:2], k)
-            self.integral = IntegralMoments.of(image, mask, self.cfg.colour_min_pixels)
+                mask = self.affine.warp(self._warm_mask(temp, room), image.shape[:2], k)
+            self.integral = IntegralMoments.of(
+                image, mask, self.cfg.colour_min_pixels, reuse=previous
+            )
             self.noise = noise_sigma(image)
-            self.background = image.reshape(-1, image.shape[2]).mean(axis=0)
+            self.background = channel_means(image)
         self.frame_index += 1
         dt = 1.0 / 30.0 if self.last_stamp is None else max(stamp_ns - self.last_stamp, 0) / 1e9
         self.last_stamp = stamp_ns
         t1 = time.perf_counter()
         self._track(temp, thermal, frame.streams.get("colour"), dt)
         t2 = time.perf_counter()
-        regions = warm_regions(temp, self.warm)
+        regions = warm_regions(temp, self.warm, room)
         self._detect(temp, thermal, regions)
         t3 = time.perf_counter()
         out = self._outputs(frame, thermal, regions)
@@ -315,9 +367,9 @@ class Cielniak2010Tracker:
         }
         return out
 
-    def _warm_mask(self, temp: NDArray[np.float32]) -> NDArray[np.bool_]:
-        """Pixels in the band of human surface temperature (as :func:`warm_regions`)."""
-        room = float(np.median(temp))
+    def _warm_mask(self, temp: NDArray[np.float32], room: float) -> NDArray[np.bool_]:
+        """Pixels in the band of human surface temperature (as :func:`warm_regions`), the
+        room being at ``room`` (:func:`room_median`)."""
         out: NDArray[np.bool_] = (temp > room + self.cfg.warm_contrast_k) & (
             temp < self.cfg.warm_max_c
         )
@@ -359,8 +411,9 @@ class Cielniak2010Tracker:
     ) -> F64:
         """Thermal contrast over its scale, plus the standing-height log-prior, minus the colour
         moments' distance to the person's model over its scale (section 4)."""
-        ll: F64 = silhouette_scores(temp, self.silhouette, states, self.contrast) / (
-            self.cfg.score_scale
+        ll: F64 = (
+            silhouette_scores(temp, self.silhouette, states, self.contrast, self.surround_room)
+            / self.cfg.score_scale
         )
         if self.cfg.ground_prior:
             heights = implied_heights(thermal.camera, thermal.pose, states)
@@ -391,18 +444,12 @@ class Cielniak2010Tracker:
         neither penalises nor is penalised by the others; its occluder tracks as usual."""
         H, W = temp.shape
         behind = self._occluded(temp, colour)
-        kept = []
+        stepped = []
         for i, t in enumerate(self.tracks):
             if i in behind:
                 t.filter.predict(dt)
                 t.filter.estimate = t.filter.particles.mean(axis=0)
                 t.occluded_frames += 1
-                est = t.filter.estimate
-                inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
-                if inside and t.occluded_frames <= self.cfg.max_occluded_frames:
-                    kept.append(t)
-                else:
-                    self._forget(t)
                 continue
             t.occluded_frames = 0
             others: list[Neighbour] = [
@@ -413,13 +460,24 @@ class Cielniak2010Tracker:
             t.filter.step(
                 functools.partial(self._loglik, temp, thermal, model=t.colour), dt, others
             )
-            est = t.filter.estimate
-            t.score = float(
-                silhouette_scores(temp, self.silhouette, est[None, :], self.contrast)[0]
+            stepped.append(t)
+        if stepped:  # the estimates' scores in one call (each row is computed on its own)
+            estimates = np.stack([t.filter.estimate for t in stepped])
+            scores = silhouette_scores(
+                temp, self.silhouette, estimates, self.contrast, self.surround_room
             )
-            t.weak_frames = t.weak_frames + 1 if t.score < self.cfg.stop_score else 0
+            for t, score in zip(stepped, scores, strict=True):
+                t.score = float(score)
+        kept = []
+        for i, t in enumerate(self.tracks):
+            est = t.filter.estimate
             inside = 0.0 <= est[0] < W and 0.0 <= est[1] < H
-            if inside and t.weak_frames < self.cfg.lost_frames:
+            if i in behind:
+                alive = inside and t.occluded_frames <= self.cfg.max_occluded_frames
+            else:
+                t.weak_frames = t.weak_frames + 1 if t.score < self.cfg.stop_score else 0
+                alive = inside and t.weak_frames < self.cfg.lost_frames
+            if alive:
                 kept.append(t)
             else:
                 self._forget(t)
@@ -437,12 +495,18 @@ class Cielniak2010Tracker:
         if self.integral is None:
             return
         boxes = [t.filter.box() for t in self.tracks]
-        for i, t in enumerate(self.tracks):
-            if t.occluded_frames or t.score < self.cfg.start_score:
-                continue
-            if any(overlap(boxes[i], b) > 0.0 for j, b in enumerate(boxes) if j != i):
-                continue
-            seen = self._observe(t.filter.estimate[None, :])[0]
+        clear = [
+            t
+            for i, t in enumerate(self.tracks)
+            if not t.occluded_frames
+            and t.score >= self.cfg.start_score
+            and not any(overlap(boxes[i], b) > 0.0 for j, b in enumerate(boxes) if j != i)
+        ]
+        if not clear:
+            return
+        # the moments of all their estimates in one call (each row is computed on its own)
+        observed = self._observe(np.stack([t.filter.estimate for t in clear]))
+        for t, seen in zip(clear, observed, strict=True):
             t.colour = (
                 ColourModel(seen)
                 if t.colour is None
@@ -461,7 +525,9 @@ class Cielniak2010Tracker:
             ):
                 continue
             state = _state_of_box(box, self.silhouette.width_ratio, aspect)
-            score = silhouette_scores(temp, self.silhouette, state[None, :], self.contrast)[0]
+            score = silhouette_scores(
+                temp, self.silhouette, state[None, :], self.contrast, self.surround_room
+            )[0]
             if score < c.start_score:
                 continue
             if c.ground_prior:

@@ -19,12 +19,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import cv2
 import numpy as np
 from numpy.typing import NDArray
 from scipy import ndimage
 
 F64 = NDArray[np.float64]
 _EIGHT = np.ones((3, 3), dtype=bool)
+_EIGHT_U8 = np.ones((3, 3), dtype=np.uint8)
 
 
 @dataclass(frozen=True)
@@ -61,15 +63,33 @@ class WarmRegions:
     person: NDArray[np.bool_]
 
 
-def warm_regions(temperature: NDArray[np.floating], params: WarmRegionParams) -> WarmRegions:
-    """The warm components of a temperature image (deg C) and their shape test."""
+def room_median(temperature: NDArray[np.float32]) -> float:
+    """The room's temperature: the median of the image."""
+    return float(np.median(temperature))
+
+
+def _dilated(mask: NDArray[np.bool_], iterations: int) -> NDArray[np.bool_]:
+    """``mask`` grown by ``iterations`` pixels, 8-connected (``ndimage.binary_dilation`` with
+    a 3x3 structure and no pixels beyond the border; OpenCV's is some 40 times faster)."""
+    out = cv2.dilate(mask.astype(np.uint8), _EIGHT_U8, iterations=iterations)
+    return np.asarray(out, dtype=bool)
+
+
+def warm_regions(
+    temperature: NDArray[np.floating], params: WarmRegionParams, room: float | None = None
+) -> WarmRegions:
+    """The warm components of a temperature image (deg C) and their shape test.
+
+    ``room``: the image's median (:func:`room_median`) when the caller has it already.
+    """
     t = np.asarray(temperature, dtype=np.float32)
-    room = float(np.median(t))
+    if room is None:
+        room = room_median(t)
     hot = t >= params.max_temp_c
     mask = t > room + params.min_contrast_k
     mask &= ~hot
     if params.hot_margin_px > 0 and hot.any():
-        mask &= ~ndimage.binary_dilation(hot, _EIGHT, iterations=params.hot_margin_px)
+        mask &= ~_dilated(hot, params.hot_margin_px)
     labels, _ = ndimage.label(mask, structure=_EIGHT)
     boxes = []
     person = []
