@@ -20,6 +20,13 @@ Usage::
 
 All variants of a scenario must print the same digest. No AVX-512 CPU can be emulated here
 (qemu's TCG lacks AVX-512); the variants cover every other code path selection.
+
+With ``--method KEY`` the recording is rendered once (natively) and the method is run on it
+under each variant instead (``rgbd-eval run REC --method KEY``); the digest is that of its
+tracks and detections files (``<name>.tracks.csv``, ``<name>.detections.csv``)::
+
+    .venv/bin/python tools/cpu_independence.py --method cielniak2010 --frames 60 \
+        configs/scenarios/cielniak2010/thermal_crossings.yaml
 """
 
 from __future__ import annotations
@@ -65,11 +72,34 @@ def render(scenario: str, frames: int, out: Path, env: dict[str, str], qemu: str
     return hashlib.sha256(out.read_bytes()).hexdigest()
 
 
+def run_method(
+    recording: Path, method: str, out: Path, env: dict[str, str], qemu: str | None
+) -> str:
+    """sha256 of the tracks and detections ``rgbd-eval run`` writes in a fresh process."""
+    cmd = [sys.executable, "-m", "rgbd_eval", "run", str(recording), "--method", method]
+    cmd += ["--out", str(out)]
+    if qemu is not None:
+        cmd = ["qemu-x86_64", "-cpu", qemu, *cmd]
+    subprocess.run(
+        cmd,
+        env={**os.environ, **env},
+        check=True,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
+    digest = hashlib.sha256()
+    for suffix in (".tracks.csv", ".detections.csv"):
+        for path in sorted(out.glob(f"*{suffix}")):
+            digest.update(path.read_bytes())
+    return digest.hexdigest()
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawTextHelpFormatter)
     ap.add_argument("scenarios", nargs="*", default=list(DEFAULT_SCENARIOS))
     ap.add_argument("--frames", type=int, default=6)
     ap.add_argument("--qemu", default="", help="comma-separated qemu CPU models, e.g. Haswell")
+    ap.add_argument("--method", default="", help="run this method on the recordings instead")
     args = ap.parse_args()
     variants: list[tuple[str, dict[str, str], str | None]] = [
         (name, env, None) for name, env in VARIANTS.items()
@@ -83,9 +113,17 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for scenario in args.scenarios:
             digests = {}
+            recording = Path(tmp) / f"{Path(scenario).stem}.mcap"
+            if args.method:
+                render(scenario, args.frames, recording, {}, None)
             for name, env, qemu in variants:
-                out = Path(tmp) / f"{Path(scenario).stem}-{name.replace(':', '_')}.mcap"
-                digests[name] = render(scenario, args.frames, out, env, qemu)
+                tag = f"{Path(scenario).stem}-{name.replace(':', '_')}"
+                if args.method:
+                    out = Path(tmp) / tag
+                    digests[name] = run_method(recording, args.method, out, env, qemu)
+                else:
+                    out = Path(tmp) / f"{tag}.mcap"
+                    digests[name] = render(scenario, args.frames, out, env, qemu)
                 print(f"{Path(scenario).stem:28s} {name:18s} {digests[name][:16]}", flush=True)
             same = len(set(digests.values())) == 1
             failed += not same
