@@ -116,15 +116,14 @@ def _cells(
     hi: np.float32,
     beyond: np.float32,
     n: int,
-    lut: NDArray[np.uint8],
-    scale: np.float32,
+    share: NDArray[np.float32],
 ) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
     """The maps ``near - free`` and ``free`` over ``n x n`` cells, in one pass over ``depth``.
 
     A pixel is near when ``lo <= z <= hi`` and free when ``z > beyond`` (float32 bounds, as
-    :func:`cv2.inRange` and :func:`cv2.compare` take a scalar for a float32 image); a cell's
-    share of each is ``lut[count] * scale``. Integer counts, then the same float32 products
-    as :meth:`.satake2009_templates.Agreement.of`: no rounding depends on the order.
+    :func:`cv2.inRange` and :func:`cv2.compare` take a scalar for a float32 image); a cell
+    with ``k`` of them has the share ``share[k]`` (:func:`area_shares`). Integer counts:
+    nothing depends on the order of the loop.
     """
     rows, cols = depth.shape[0] // n, depth.shape[1] // n
     m = cols * n
@@ -148,30 +147,22 @@ def _cells(
             for x in range(j * n, j * n + n):
                 a += near_px[x]
                 b += free_px[x]
-            f = np.float32(lut[b]) * scale
-            diff[i, j] = np.float32(lut[a]) * scale - f
+            f = share[b]
+            diff[i, j] = share[a] - f
             free[i, j] = f
     return diff, free
 
 
 _cells_kernel: Callable[
-    [
-        NDArray[np.float32],
-        np.float32,
-        np.float32,
-        np.float32,
-        int,
-        NDArray[np.uint8],
-        np.float32,
-    ],
+    [NDArray[np.float32], np.float32, np.float32, np.float32, int, NDArray[np.float32]],
     tuple[NDArray[np.float32], NDArray[np.float32]],
 ] = numba.njit(cache=True)(_cells)
 
 
 @functools.cache
-def area_lut(n: int) -> NDArray[np.uint8]:
-    """What ``cv2.resize(..., INTER_AREA)`` makes of an ``n x n`` cell of 0/255 pixels, ``k`` of
-    them 255, for ``k = 0 .. n^2`` (indexed by ``k``).
+def area_shares(n: int) -> NDArray[np.float32]:
+    """The share :meth:`.satake2009_templates.Agreement.of` gives an ``n x n`` cell of 0/255
+    pixels averaged with ``cv2.resize(..., INTER_AREA)``, ``k`` of them 255, for ``k = 0 .. n^2``.
 
     On an integer factor OpenCV sums the cell exactly and rounds the mean once, so its
     output depends on the count alone; asking OpenCV itself keeps its rounding.
@@ -184,8 +175,9 @@ def area_lut(n: int) -> NDArray[np.uint8]:
         cells[:, c * n : (c + 1) * n] = cell.reshape(n, n)
     if n > 1:
         cells = np.asarray(cv2.resize(cells, (k + 1, 1), interpolation=cv2.INTER_AREA), np.uint8)
-    lut: NDArray[np.uint8] = cells[0].copy()
-    return lut
+    share: NDArray[np.float32] = st.Agreement.of(cells[:1], cells[:1], 255.0).free[0].copy()
+    share.flags.writeable = False
+    return share
 
 
 def _reduced(
@@ -207,8 +199,7 @@ def _reduced(
         np.float32(distance + params.band_m),
         np.float32(distance + params.gap_m),
         n,
-        area_lut(n),
-        np.float32(1.0 / 255.0),
+        area_shares(n),
     )
     return st.Agreement(diff, free)
 
