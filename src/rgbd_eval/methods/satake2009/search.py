@@ -259,14 +259,15 @@ def search_whole(
             if cv2.minMaxLoc(scores)[1] < params.min_score:
                 continue  # nothing to collect (the common case: one C pass, no allocation)
             ys, xs = np.nonzero(scores >= params.min_score)
-            order = np.argsort(-scores[ys, xs], kind="stable")[:per_template]
-            for y, x in zip(ys[order], xs[order], strict=True):
-                found.append(
-                    st.Match(
-                        (x + t.anchor[0]) * n, (y + t.anchor[1]) * n, D, float(scores[y, x]),
-                        t.orientation_deg, (int(x) * n, int(y) * n, tw * n, th * n),
-                    )
-                )  # fmt: skip
+            values = scores[ys, xs]
+            order = np.argsort(-values, kind="stable")[:per_template]
+            ys, xs = ys[order], xs[order]
+            us, vs = (xs + t.anchor[0]) * n, (ys + t.anchor[1]) * n  # the head top
+            size = (tw * n, th * n)
+            for u, v, score, x0, y0 in zip(
+                us, vs, values[order].tolist(), (xs * n).tolist(), (ys * n).tolist(), strict=True
+            ):
+                found.append(st.Match(u, v, D, score, t.orientation_deg, (x0, y0, *size)))
     return found
 
 
