@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import cv2
+import numpy as np
 import pytest
 
 from rgbd_eval.methods.satake2009 import search as search
@@ -94,3 +96,26 @@ def test_suppression_keeps_the_best_of_each_overlapping_group() -> None:
     assert search.suppress([], 0.3) == []
     e, f = m((50, 0, 4, 4), 0.5), m((60, 0, 4, 4), 0.5)
     assert search.suppress([e, f], 0.3) == [e, f]
+
+
+@pytest.mark.parametrize("n", [1, 2, 3, 4, 7, 13])
+def test_reduced_maps_are_opencvs_threshold_and_area_average(n: int) -> None:
+    # The one-pass cell counts equal inRange/compare, INTER_AREA and Agreement.of bit for
+    # bit: depths on and either side of the float32 bounds D - band, D + band, D + gap,
+    # no depth (+inf), and a map whose size is not a multiple of n (last cells dropped).
+    rng = np.random.default_rng(n)
+    for D in rng.uniform(0.8, 7.0, 20):
+        edges = [np.float32(D - 0.3), np.float32(D + 0.3), np.float32(D + 0.5)]
+        values = [np.nextafter(e, np.float32(s)) for e in edges for s in (-np.inf, np.inf)]
+        values += [*edges, np.float32(np.inf), np.float32(0.0), np.float32(D)]
+        depth = np.array(values, np.float32)[rng.integers(0, len(values), (5 * n + 3, 7 * n + 2))]
+        near, free = st.agreement_u8_far(depth, float(D), 0.3, 0.5)
+        if n > 1:
+            h, w = (depth.shape[0] // n) * n, (depth.shape[1] // n) * n
+            size = (w // n, h // n)
+            near = cv2.resize(near[:h, :w], size, interpolation=cv2.INTER_AREA)
+            free = cv2.resize(free[:h, :w], size, interpolation=cv2.INTER_AREA)
+        want = st.Agreement.of(near, free, 255.0)
+        got = search._reduced(depth, float(D), n, PARAMS)
+        assert got.diff.tobytes() == want.diff.tobytes()
+        assert got.free.tobytes() == want.free.tobytes()

@@ -98,3 +98,14 @@ def test_bad_parameters_raise() -> None:
             (4, 4),
             stereo.make_matcher(stereo.SgbmParams()),
         )
+
+
+def test_depth_in_one_pass_is_depth_from_disparity() -> None:
+    # Every raw SGBM value (1/16 px; <= 0: no match) gives the float32 depth of
+    # depth_from_disparity(disparity) bit for bit, NaN included.
+    raw = np.arange(-32768, 32768, dtype=np.int32).astype(np.int16).reshape(256, 256)
+    disp = raw.astype(np.float32) / 16.0
+    disp[raw <= 0] = np.nan
+    want = stereo.depth_from_disparity(disp, 214.8, 0.12)
+    got = stereo._depth_kernel(raw, np.float32(214.8 * 0.12))
+    assert got.tobytes() == want.tobytes()

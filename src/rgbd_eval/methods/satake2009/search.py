@@ -16,13 +16,16 @@ read of the recording computes it again.
 
 from __future__ import annotations
 
+import functools
 import math
 import threading
 import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import cv2
+import numba
 import numpy as np
 from numpy.typing import NDArray
 
@@ -107,24 +110,98 @@ def level(templates: list[st.DistanceTemplate], distance: float, fx: float, rows
     return max(1, round(float(tall) / rows))
 
 
+def _cells(
+    depth: NDArray[np.float32],
+    lo: np.float32,
+    hi: np.float32,
+    beyond: np.float32,
+    n: int,
+    share: NDArray[np.float32],
+) -> tuple[NDArray[np.float32], NDArray[np.float32]]:
+    """The maps ``near - free`` and ``free`` over ``n x n`` cells, in one pass over ``depth``.
+
+    A pixel is near when ``lo <= z <= hi`` and free when ``z > beyond`` (float32 bounds, as
+    :func:`cv2.inRange` and :func:`cv2.compare` take a scalar for a float32 image); a cell
+    with ``k`` of them has the share ``share[k]`` (:func:`area_shares`). Integer counts:
+    nothing depends on the order of the loop.
+    """
+    rows, cols = depth.shape[0] // n, depth.shape[1] // n
+    m = cols * n
+    diff = np.empty((rows, cols), np.float32)
+    free = np.empty((rows, cols), np.float32)
+    near_px = np.zeros(m, np.int32)  # per pixel column: counts over the cell's rows
+    free_px = np.zeros(m, np.int32)
+    for i in range(rows):
+        for x in range(m):
+            near_px[x] = 0
+            free_px[x] = 0
+        for y in range(i * n, i * n + n):
+            row = depth[y]
+            for x in range(m):
+                z = row[x]
+                near_px[x] += np.int32(1) if (z >= lo) & (z <= hi) else np.int32(0)
+                free_px[x] += np.int32(1) if z > beyond else np.int32(0)
+        for j in range(cols):
+            a = 0
+            b = 0
+            for x in range(j * n, j * n + n):
+                a += near_px[x]
+                b += free_px[x]
+            f = share[b]
+            diff[i, j] = share[a] - f
+            free[i, j] = f
+    return diff, free
+
+
+_cells_kernel: Callable[
+    [NDArray[np.float32], np.float32, np.float32, np.float32, int, NDArray[np.float32]],
+    tuple[NDArray[np.float32], NDArray[np.float32]],
+] = numba.njit(cache=True)(_cells)
+
+
+@functools.cache
+def area_shares(n: int) -> NDArray[np.float32]:
+    """The share :meth:`.satake2009_templates.Agreement.of` gives an ``n x n`` cell of 0/255
+    pixels averaged with ``cv2.resize(..., INTER_AREA)``, ``k`` of them 255, for ``k = 0 .. n^2``.
+
+    On an integer factor OpenCV sums the cell exactly and rounds the mean once, so its
+    output depends on the count alone; asking OpenCV itself keeps its rounding.
+    """
+    k = n * n
+    cells = np.zeros((n, n * (k + 1)), np.uint8)
+    for c in range(1, k + 1):
+        cell = np.zeros(k, np.uint8)
+        cell[:c] = 255
+        cells[:, c * n : (c + 1) * n] = cell.reshape(n, n)
+    if n > 1:
+        cells = np.asarray(cv2.resize(cells, (k + 1, 1), interpolation=cv2.INTER_AREA), np.uint8)
+    share: NDArray[np.float32] = st.Agreement.of(cells[:1], cells[:1], 255.0).free[0].copy()
+    share.flags.writeable = False
+    return share
+
+
 def _reduced(
     depth: NDArray[np.float32], distance: float, n: int, params: MatchParams
 ) -> st.Agreement:
     """The agreement maps at ``distance``, averaged over ``n x n`` cells (a partial last cell dropped).
 
     ``depth`` has no NaN: no depth is +inf (:func:`.satake2009_templates.no_depth_far`).
+    The same maps as :func:`.satake2009_templates.agreement_u8_far`, each averaged down with
+    ``INTER_AREA`` and put through :meth:`.satake2009_templates.Agreement.of`, in one pass.
     """
-    near, free = st.agreement_u8_far(depth, distance, params.band_m, params.gap_m)
-    if n > 1:
-        h, w = near.shape
-        size = (w // n, h // n)
-        if size[0] and size[1]:
-            cells = (slice(0, size[1] * n), slice(0, size[0] * n))
-            near = np.asarray(cv2.resize(near[cells], size, interpolation=cv2.INTER_AREA), np.uint8)
-            free = np.asarray(cv2.resize(free[cells], size, interpolation=cv2.INTER_AREA), np.uint8)
-        else:
-            near, free = near[:0, :0], free[:0, :0]
-    return st.Agreement.of(near, free, 255.0)
+    h, w = depth.shape
+    if h < n or w < n:
+        empty = np.zeros((0, 0), np.float32)
+        return st.Agreement(empty, empty)
+    diff, free = _cells_kernel(
+        depth,
+        np.float32(distance - params.band_m),
+        np.float32(distance + params.band_m),
+        np.float32(distance + params.gap_m),
+        n,
+        area_shares(n),
+    )
+    return st.Agreement(diff, free)
 
 
 def suppress(matches: list[st.Match], iou: float) -> list[st.Match]:
@@ -182,14 +259,15 @@ def search_whole(
             if cv2.minMaxLoc(scores)[1] < params.min_score:
                 continue  # nothing to collect (the common case: one C pass, no allocation)
             ys, xs = np.nonzero(scores >= params.min_score)
-            order = np.argsort(-scores[ys, xs], kind="stable")[:per_template]
-            for y, x in zip(ys[order], xs[order], strict=True):
-                found.append(
-                    st.Match(
-                        (x + t.anchor[0]) * n, (y + t.anchor[1]) * n, D, float(scores[y, x]),
-                        t.orientation_deg, (int(x) * n, int(y) * n, tw * n, th * n),
-                    )
-                )  # fmt: skip
+            values = scores[ys, xs]
+            order = np.argsort(-values, kind="stable")[:per_template]
+            ys, xs = ys[order], xs[order]
+            us, vs = (xs + t.anchor[0]) * n, (ys + t.anchor[1]) * n  # the head top
+            size = (tw * n, th * n)
+            for u, v, score, x0, y0 in zip(
+                us, vs, values[order].tolist(), (xs * n).tolist(), (ys * n).tolist(), strict=True
+            ):
+                found.append(st.Match(u, v, D, score, t.orientation_deg, (x0, y0, *size)))
     return found
 
 
