@@ -13,9 +13,11 @@ from rgbd_eval.errors import ScoringError
 from rgbd_eval.metrics.selection import (
     FrameSelection,
     _select_checking,
+    _select_sequence,
     is_ignored,
     is_scored_track,
     select_frame,
+    select_frames,
     tracks_on_ignored,
 )
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
@@ -124,3 +126,28 @@ def test_select_frame_names_the_problems_as_before() -> None:
     assert select_frame(3, [gt(2), bad], [], Gating.IOU, 0.5, 0.0).ignored_gt_ids == [4]
     with pytest.raises(ScoringError, match="ground-truth id 4 has an invalid box"):
         select_frame(3, [gt(2), bad], [track(5)], Gating.IOU, 0.5, 0.0)
+
+
+def test_select_frames_agrees_with_select_frame() -> None:
+    # The sequence's fields are read and checked once as arrays; the frames' selections must
+    # be select_frame's, and a problem is named with its frame as select_frame names it.
+    rng = np.random.default_rng(6)
+    for gating, threshold in ((Gating.IOU, 0.5), (Gating.METRIC, 1.0)):
+        frames = [_random_frame(rng, gating) for _ in range(300)]
+        # Every object with the gated field: the selection of the whole sequence at once.
+        field = "box2d" if gating is Gating.IOU else "world_xyz"
+        frames = [([o for o in g if getattr(o, field) is not None], t) for g, t in frames]
+        gts, tracks = [f[0] for f in frames], [f[1] for f in frames]
+        together = _select_sequence(gts, tracks, gating, threshold, 0.5)
+        assert together is not None
+        assert sum(len(s.dropped_track_ids) > 0 for s in together) > 10
+        for k, (objects, frame_tracks) in enumerate(frames):
+            alone = select_frame(k, objects, frame_tracks, gating, threshold, 0.5)
+            assert _same(together[k], alone), (gating, k)
+    boxes = [[gt(1), gt(2)], [gt(1), gt(3)], [gt(4), gt(4, ignore=True)]]
+    with pytest.raises(ScoringError, match=r"frame 2: ground-truth id\(s\) \[4\] appear"):
+        select_frames(boxes, [[track(1)], [], [track(1)]], Gating.IOU, 0.5, 0.0)
+    with pytest.raises(ScoringError, match=r"frame 1: track id\(s\) \[7\] appear"):
+        select_frames([[], [], []], [[track(7)], [track(7), track(7)], []], Gating.IOU, 0.5, 0.0)
+    with pytest.raises(ScoringError, match="frame 1: ground-truth id 3 has an invalid box"):
+        select_frames([[], [gt(3, (0.0, 0.0, 1.0, -1.0))]], [[], []], Gating.IOU, 0.5, 0.0)
