@@ -133,16 +133,11 @@ def hota_counts(
     with np.errstate(divide="ignore", invalid="ignore"):
         alignment = potential / (gt_count[:, None] + track_count[None, :] - potential)
     alpha = np.array(ALPHAS)[:, None] - EPS
-    tp = np.zeros(_N, dtype=np.int64)
-    fn = np.zeros(_N, dtype=np.int64)
-    fp = np.zeros(_N, dtype=np.int64)
     loc = np.zeros(_N)
     pair_keys: list[IntArray] = []
     pair_sims: list[FloatArray] = []
     for frame, (g, t, s) in enumerate(zip(gt, tracks, similarity, strict=True)):
         if len(g) == 0 or len(t) == 0:
-            fp += len(t)
-            fn += len(g)
             continue
         distinct = distinct_pairs(s > 0)
         if distinct is None:
@@ -151,15 +146,17 @@ def hota_counts(
             rows, cols = distinct
         sims = s[rows, cols]
         matched = sims[None, :] >= alpha  # (alphas, pairs); alpha - eps, as TrackEval
-        n = matched.sum(axis=1)
-        tp += n
-        fn += len(g) - n
-        fp += len(t) - n
-        loc += np.where(matched, sims[None, :], 0.0).sum(axis=1)
+        loc += np.where(matched, sims[None, :], 0.0).sum(axis=1)  # frame by frame, as TrackEval
         pair_keys.append(g[rows] * num_tracks + t[cols])
         pair_sims.append(sims)
         if pairs is not None:
             pairs.append((frame, g[rows], t[cols], sims))
+    # The true positives at each alpha are the frames' matched pairs at or above it; every
+    # other ground-truth object is a miss, every other track a false positive.
+    matched_sims = np.concatenate([np.zeros(0), *pair_sims])
+    tp = (matched_sims[None, :] >= alpha).sum(axis=1)
+    fn = sum(len(g) for g in gt) - tp
+    fp = sum(len(t) for t in tracks) - tp
     ass = np.zeros(_N)
     if pair_keys:
         keys = np.concatenate(pair_keys)
