@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 import re
 from pathlib import Path
@@ -324,3 +325,38 @@ def test_score_reports_breakdowns_intervals_and_where_it_fails(tmp_path: Path) -
     assert "## Confidence threshold curve" in md
     html = (out / "report.html").read_text()
     assert html.index("Where it fails") < html.index("<h2>Metrics</h2>")
+
+
+def test_events_csv_is_what_the_csv_module_writes() -> None:
+    # events_csv joins its lines itself: they must stay the csv module's, byte for byte.
+    from rgbd_eval.metrics import FrameEvents, Match
+    from rgbd_eval.report.run import EVENTS_HEADER, events_csv
+
+    frames = [
+        FrameEvents(
+            0,
+            (Match(1, 7, 0.5, False, False), Match(-2, 8, 1 / 3, True, True)),
+            (3,),
+            (9,),
+            (4, 5),
+            (6,),
+        ),
+        FrameEvents(1, (), (), (), (), ()),
+        FrameEvents(2, (Match(2**52, 7, 1.0, True, False),), (), (10, 11), (), ()),
+    ]
+    rows: list[list[object]] = []
+    for e, stamp, number in zip(frames, (0, 10**18, 5), (1, 2, 3), strict=True):
+        for m in e.matches:
+            kind = "switch" if m.id_switch else "match"
+            sim = f"{m.similarity:.6f}"
+            rows.append([number, stamp, kind, m.gt_id, m.track_id, sim, int(m.recall_error)])
+        rows += [[number, stamp, "miss", g, "", "", ""] for g in e.misses]
+        rows += [[number, stamp, "fp", "", t, "", ""] for t in e.false_positives]
+        rows += [[number, stamp, "ignored_gt", g, "", "", ""] for g in e.ignored_gt]
+        rows += [[number, stamp, "ignored_track", "", t, "", ""] for t in e.ignored_tracks]
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(EVENTS_HEADER)
+    writer.writerows(rows)
+    assert events_csv(frames, (0, 10**18, 5), (1, 2, 3)) == buf.getvalue()
+    assert events_csv([], (), ()) == ",".join(EVENTS_HEADER) + "\n"

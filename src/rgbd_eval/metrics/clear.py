@@ -48,7 +48,7 @@ from rgbd_eval.metrics.matching import (
     MotChallengeMatcher,
     MotMetricsMatcher,
 )
-from rgbd_eval.metrics.selection import FrameSelection, select_frame
+from rgbd_eval.metrics.selection import FrameSelection, select_frames
 from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 
@@ -119,10 +119,9 @@ def evaluate_sequence(
             f"{len(track_frames)}; they must be index-aligned"
         )
     threshold = config.effective_threshold()
-    selections = [
-        select_frame(index, gt_objects, tracks, config.gating, threshold, config.min_visibility)
-        for index, (gt_objects, tracks) in enumerate(zip(gt_frames, track_frames, strict=True))
-    ]
+    selections = select_frames(
+        gt_frames, track_frames, config.gating, threshold, config.min_visibility
+    )
     return score_selections(selections, config)
 
 

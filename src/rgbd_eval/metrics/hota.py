@@ -22,7 +22,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from rgbd_eval.metrics.gating import EPS, FloatArray
-from rgbd_eval.metrics.matching import IntArray, conflict_free
+from rgbd_eval.metrics.matching import IntArray, distinct_pairs
 
 #: TrackEval's localisation thresholds: ``np.arange(0.05, 0.99, 0.05)``.
 ALPHAS: tuple[float, ...] = tuple(float(a) for a in np.arange(0.05, 0.99, 0.05))
@@ -121,43 +121,42 @@ def hota_counts(
     similarity)`` (for :mod:`rgbd_eval.metrics.frames`).
     """
     potential = np.zeros((num_gt, num_tracks))
-    gt_count = np.zeros(num_gt)
-    track_count = np.zeros(num_tracks)
+    # Ids are unique within a frame: counting them is counting their frames.
+    empty = np.zeros(0, dtype=np.int64)
+    gt_count = np.bincount(np.concatenate([empty, *gt]), minlength=num_gt).astype(np.float64)
+    track_count = np.bincount(np.concatenate([empty, *tracks]), minlength=num_tracks).astype(
+        np.float64
+    )
     for g, t, s in zip(gt, tracks, similarity, strict=True):
         if len(g) and len(t):
-            potential[np.ix_(g, t)] += _sim_iou(s)
-        gt_count[g] += 1
-        track_count[t] += 1
+            potential[g[:, None], t] += _sim_iou(s)
     with np.errstate(divide="ignore", invalid="ignore"):
         alignment = potential / (gt_count[:, None] + track_count[None, :] - potential)
-    alpha = np.array(ALPHAS)[:, None]
-    tp = np.zeros(_N, dtype=np.int64)
-    fn = np.zeros(_N, dtype=np.int64)
-    fp = np.zeros(_N, dtype=np.int64)
+    alpha = np.array(ALPHAS)[:, None] - EPS
     loc = np.zeros(_N)
     pair_keys: list[IntArray] = []
     pair_sims: list[FloatArray] = []
     for frame, (g, t, s) in enumerate(zip(gt, tracks, similarity, strict=True)):
         if len(g) == 0 or len(t) == 0:
-            fp += len(t)
-            fn += len(g)
             continue
-        positive = s > 0
-        if conflict_free(positive):
-            rows, cols = np.nonzero(positive)
+        distinct = distinct_pairs(s > 0)
+        if distinct is None:
+            rows, cols = linear_sum_assignment(-(alignment[g[:, None], t] * s))
         else:
-            rows, cols = linear_sum_assignment(-(alignment[np.ix_(g, t)] * s))
+            rows, cols = distinct
         sims = s[rows, cols]
-        matched = sims[None, :] >= alpha - EPS  # (alphas, pairs)
-        n = matched.sum(axis=1)
-        tp += n
-        fn += len(g) - n
-        fp += len(t) - n
-        loc += np.where(matched, sims[None, :], 0.0).sum(axis=1)
+        matched = sims[None, :] >= alpha  # (alphas, pairs); alpha - eps, as TrackEval
+        loc += np.where(matched, sims[None, :], 0.0).sum(axis=1)  # frame by frame, as TrackEval
         pair_keys.append(g[rows] * num_tracks + t[cols])
         pair_sims.append(sims)
         if pairs is not None:
             pairs.append((frame, g[rows], t[cols], sims))
+    # The true positives at each alpha are the frames' matched pairs at or above it; every
+    # other ground-truth object is a miss, every other track a false positive.
+    matched_sims = np.concatenate([np.zeros(0), *pair_sims])
+    tp = (matched_sims[None, :] >= alpha).sum(axis=1)
+    fn = sum(len(g) for g in gt) - tp
+    fp = sum(len(t) for t in tracks) - tp
     ass = np.zeros(_N)
     if pair_keys:
         keys = np.concatenate(pair_keys)

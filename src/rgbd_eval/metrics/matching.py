@@ -49,18 +49,27 @@ class FrameMatch(NamedTuple):
 EMPTY_MATCH = FrameMatch(_EMPTY, _EMPTY, np.zeros(0, dtype=bool))
 
 
+def distinct_pairs(valid: BoolArray) -> tuple[IntArray, IntArray] | None:
+    """The valid pairs (rows, columns) when no row and no column holds two of them (then
+    they are the assignment), else None."""
+    rows, cols = np.nonzero(valid)
+    if len(rows) > 1 and (
+        len(set(rows.tolist())) < len(rows) or len(set(cols.tolist())) < len(cols)
+    ):
+        return None
+    return rows.astype(np.int64, copy=False), cols.astype(np.int64, copy=False)
+
+
 def conflict_free(valid: BoolArray) -> bool:
     """Whether no row and no column holds two valid pairs (then they are the assignment)."""
-    return bool(valid.sum(axis=0).max() <= 1 and valid.sum(axis=1).max() <= 1)
+    return distinct_pairs(valid) is not None
 
 
 def max_similarity_pairs(valid: BoolArray, score: FloatArray) -> tuple[IntArray, IntArray]:
     """TrackEval's assignment: maximise ``score`` over valid pairs (score 0 elsewhere)."""
-    if not valid.any():
-        return _EMPTY, _EMPTY
-    if conflict_free(valid):
-        rows, cols = np.nonzero(valid)
-        return rows.astype(np.int64), cols.astype(np.int64)
+    pairs = distinct_pairs(valid)
+    if pairs is not None:
+        return pairs
     masked = np.where(valid, score, 0.0)
     rows, cols = linear_sum_assignment(-masked)
     keep = masked[rows, cols] > EPS
@@ -102,11 +111,12 @@ class MotChallengeMatcher:
         """Match one frame; a frame without ground truth or tracks leaves the memory as is."""
         if len(gt) == 0 or len(tracks) == 0:
             return EMPTY_MATCH
-        if valid.any() and not conflict_free(valid):
+        pairs = distinct_pairs(valid)
+        if pairs is None:
             continued = tracks[None, :] == self.prev_step[gt][:, None]
             rows, cols = max_similarity_pairs(valid, 1000.0 * continued + similarity)
         else:
-            rows, cols = max_similarity_pairs(valid, similarity)
+            rows, cols = pairs
         matched_gt, matched_tracks = gt[rows], tracks[cols]
         previous = self.last[matched_gt]
         switch = (previous >= 0) & (previous != matched_tracks)

@@ -332,19 +332,23 @@ def events_csv(
     match; ``switch`` rows are matches that are id switches. ``frame`` is the frame index,
     or the input's own frame number (MOTChallenge counts from 1) where given.
     """
-    rows: list[list[object]] = []
+    # Every field is a whole number, a fixed word or a formatted float: the lines are what
+    # csv.writer makes of them (nothing to quote), joined without its per-row cost.
+    lines = [",".join(EVENTS_HEADER)]
     numbers = frame_numbers if frame_numbers is not None else [e.frame for e in frames]
     for events, stamp, f in zip(frames, stamps_ns, numbers, strict=True):
-        for m in events.matches:
-            kind = "switch" if m.id_switch else "match"
-            rows.append(
-                [f, stamp, kind, m.gt_id, m.track_id, f"{m.similarity:.6f}", int(m.recall_error)]
-            )
-        rows += [[f, stamp, "miss", g, "", "", ""] for g in events.misses]
-        rows += [[f, stamp, "fp", "", t, "", ""] for t in events.false_positives]
-        rows += [[f, stamp, "ignored_gt", g, "", "", ""] for g in events.ignored_gt]
-        rows += [[f, stamp, "ignored_track", "", t, "", ""] for t in events.ignored_tracks]
-    return _csv(rows, EVENTS_HEADER)
+        at = f"{f},{stamp},"
+        lines += [
+            f"{at}{'switch' if m.id_switch else 'match'},{m.gt_id},{m.track_id},"
+            f"{m.similarity:.6f},{int(m.recall_error)}"
+            for m in events.matches
+        ]
+        lines += [f"{at}miss,{g},,," for g in events.misses]
+        lines += [f"{at}fp,,{t},," for t in events.false_positives]
+        lines += [f"{at}ignored_gt,{g},,," for g in events.ignored_gt]
+        lines += [f"{at}ignored_track,,{t},," for t in events.ignored_tracks]
+    lines.append("")
+    return "\n".join(lines)
 
 
 def write_run(
