@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import base64
 import re
+import xml.etree.ElementTree as ET
 from html.parser import HTMLParser
 from pathlib import Path
 
@@ -14,6 +15,7 @@ import pytest
 from tests.report_html.conftest import FRAMES
 
 #: Attributes that make a browser fetch something.
+SVG = "{http://www.w3.org/2000/svg}"
 _URL_ATTRIBUTES = {"src", "href", "srcset", "poster", "data", "action", "formaction", "background"}
 
 
@@ -109,7 +111,17 @@ def test_page_is_self_contained_and_its_images_decode(pages: dict[str, Path], pa
     assert parser.images, "every page shows at least one plot"
     for uri in parser.images:
         head, _, payload = uri.partition(",")
-        assert head in ("data:image/png;base64", "data:image/jpeg;base64")
+        assert head in (
+            "data:image/png;base64",
+            "data:image/jpeg;base64",
+            "data:image/svg+xml;base64",
+        )
+        if head == "data:image/svg+xml;base64":  # the error timeline: well-formed SVG with a plot
+            svg = ET.fromstring(base64.b64decode(payload))
+            assert (
+                svg.tag == "{http://www.w3.org/2000/svg}svg" and svg.find(f"{SVG}path") is not None
+            )
+            continue
         image = cv2.imdecode(np.frombuffer(base64.b64decode(payload), np.uint8), cv2.IMREAD_COLOR)
         assert image is not None and image.shape[0] > 50 and image.shape[1] > 50
         assert image.std() > 5  # not a flat colour
@@ -125,7 +137,7 @@ def test_run_page_content(pages: dict[str, Path], run_dir: Path) -> None:
     assert "None: the method's defaults" in html  # no --set: no config difference
     # The metrics table shows the report's MOTA as the terminal table does.
     assert f"{100 * seq['metrics']['mota']:.1f}%" in html
-    # Worst frames are JPEG photographs; plots are PNG.
+    # Worst frames are JPEG photographs; plots are PNG, the error timeline SVG.
     shots = re.findall(r'<img src="data:image/jpeg;base64,[^"]*" alt="short frame (\d+)"', html)
     assert shots and len(shots) <= 6
     assert shots == sorted(shots, key=int)

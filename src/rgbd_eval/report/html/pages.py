@@ -145,7 +145,7 @@ def _section(
     return SequenceSection(
         view.name,
         uri,
-        data_uri(plots.timeline(errors, shown)) if scores is not None else None,
+        data_uri(plots.timeline(errors, shown), "image/svg+xml") if scores is not None else None,
         tuple(shots),
         sum(e.total > 0 for e in errors),
         video,
