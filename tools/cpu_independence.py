@@ -56,10 +56,9 @@ VARIANTS: dict[str, dict[str, str]] = {
 }
 
 
-def render(scenario: str, frames: int, out: Path, env: dict[str, str], qemu: str | None) -> str:
-    """sha256 of the recording ``synth`` writes in a fresh process."""
-    cmd = [sys.executable, "-m", "rgbd_eval", "synth", scenario, "--frames", str(frames)]
-    cmd += ["-o", str(out)]
+def _cli(args: list[str], env: dict[str, str], qemu: str | None) -> None:
+    """``rgbd-eval ARGS`` in a fresh process, under ``qemu-x86_64 -cpu QEMU`` if given."""
+    cmd = [sys.executable, "-m", "rgbd_eval", *args]
     if qemu is not None:
         cmd = ["qemu-x86_64", "-cpu", qemu, *cmd]
     subprocess.run(
@@ -69,6 +68,11 @@ def render(scenario: str, frames: int, out: Path, env: dict[str, str], qemu: str
         stdout=subprocess.DEVNULL,
         stderr=subprocess.PIPE,
     )
+
+
+def render(scenario: str, frames: int, out: Path, env: dict[str, str], qemu: str | None) -> str:
+    """sha256 of the recording ``synth`` writes in a fresh process."""
+    _cli(["synth", scenario, "--frames", str(frames), "-o", str(out)], env, qemu)
     return hashlib.sha256(out.read_bytes()).hexdigest()
 
 
@@ -76,17 +80,7 @@ def run_method(
     recording: Path, method: str, out: Path, env: dict[str, str], qemu: str | None
 ) -> str:
     """sha256 of the tracks and detections ``rgbd-eval run`` writes in a fresh process."""
-    cmd = [sys.executable, "-m", "rgbd_eval", "run", str(recording), "--method", method]
-    cmd += ["--out", str(out)]
-    if qemu is not None:
-        cmd = ["qemu-x86_64", "-cpu", qemu, *cmd]
-    subprocess.run(
-        cmd,
-        env={**os.environ, **env},
-        check=True,
-        stdout=subprocess.DEVNULL,
-        stderr=subprocess.PIPE,
-    )
+    _cli(["run", str(recording), "--method", method, "--out", str(out)], env, qemu)
     digest = hashlib.sha256()
     for suffix in (".tracks.csv", ".detections.csv"):
         for path in sorted(out.glob(f"*{suffix}")):
