@@ -6,10 +6,11 @@
 
 Every variant runs on every recording for every tracker seed (``tracker.seed``); the
 counts are summed over the recordings per seed and the mean (min .. max) over the seeds
-of ID switches, MOTA and IDF1 printed, with the ID switches per recording. The parameters
-of ``methods/cielniak2010/method.yaml`` were chosen with it on recordings rendered with
-scenario seed 100 and tracker seeds 100-102, never on the seeds ``reproduce`` reports
-(scenario seeds 40/41 of ``configs/scenarios/cielniak2010/``, tracker seeds 0-2).
+of ID switches, MOTA and IDF1 printed, with the ID switches per recording. The tracker
+values of ``methods/cielniak2010/method.yaml`` (surround, surround_weight, colour_scale) were
+chosen with it on the tuning scenes (``configs/scenarios/tuning/cielniak2010_*_tuning.yaml``
+at scenario seeds 201/211 and 202/212, tracker seeds 100-101), never on the scenes
+``reproduce`` scores.
 """
 
 from __future__ import annotations

@@ -117,7 +117,7 @@ class Cielniak2010TrackerConfig(ComponentConfig):
     contrast_offset: float = Field(0.05, gt=0.0, le=0.5, description="share of the height")
     contrast_saturation_k: float = Field(8.0, gt=0.0)
     surround: float = Field(0.15, gt=0.0, description="share of h outside the contour")
-    surround_weight: float = Field(1.0, ge=0.0, description="K of score per K of warm surround")
+    surround_weight: float = Field(0.5, ge=0.0, description="K of score per K of warm surround")
     min_height_px: float = Field(20.0, gt=0.0)
     max_height_px: float = Field(400.0, gt=0.0)
     ground_prior: bool = Field(True, description="weigh by the implied standing height")
