@@ -116,11 +116,13 @@ def test_page_is_self_contained_and_its_images_decode(pages: dict[str, Path], pa
             "data:image/jpeg;base64",
             "data:image/svg+xml;base64",
         )
-        if head == "data:image/svg+xml;base64":  # the error timeline: well-formed SVG with a plot
+        if head == "data:image/svg+xml;base64":  # timeline and analysis plots: well-formed SVG
             svg = ET.fromstring(base64.b64decode(payload))
-            assert (
-                svg.tag == "{http://www.w3.org/2000/svg}svg" and svg.find(f"{SVG}path") is not None
-            )
+            assert svg.tag == f"{SVG}svg"
+            shapes = {f"{SVG}{t}" for t in ("path", "circle", "rect", "line")}
+            marks = [e for e in svg.iter() if e.tag in shapes][1:]  # after the white background
+            labels = [e.text for e in svg.iter(f"{SVG}text")]
+            assert marks and labels, "a plot draws marks and labels its axes"
             continue
         image = cv2.imdecode(np.frombuffer(base64.b64decode(payload), np.uint8), cv2.IMREAD_COLOR)
         assert image is not None and image.shape[0] > 50 and image.shape[1] > 50

@@ -12,6 +12,9 @@ from rgbd_eval.report import analysis as an
 from rgbd_eval.report.html import analysis_plots
 from rgbd_eval.report.html.render import data_uri
 
+#: The MIME type of the analysis plots (:mod:`rgbd_eval.report.html.analysis_plots`).
+SVG = "image/svg+xml"
+
 #: The metrics of the interval plot (shares, drawn in %): (metric, label).
 INTERVAL_PANELS = (
     ("mota", "MOTA"),
@@ -106,7 +109,7 @@ def _breakdown_figure(part: an.Part) -> str | None:
         intervals = [part.band_intervals.get((b.kind, label), {}) for label in labels]
         gt = [band.counts.num_gt for band in b.bands]
         rows.append((an.BREAKDOWN_TITLES[b.kind], labels, metrics, intervals, gt, b.with_fp))
-    return data_uri(analysis_plots.breakdown_panels(rows)) if rows else None
+    return data_uri(analysis_plots.breakdown_panels(rows), SVG) if rows else None
 
 
 def _curve_view(analysis: an.Analysis) -> CurveView | None:
@@ -134,7 +137,7 @@ def _curve_view(analysis: an.Analysis) -> CurveView | None:
     figure = analysis_plots.threshold_curve(
         [p.threshold for p in curve.points], summaries, curve.best
     )
-    return CurveView(True, "", rows, best, data_uri(figure))
+    return CurveView(True, "", rows, best, data_uri(figure, SVG))
 
 
 def _split(text: str) -> tuple[str, str]:
@@ -186,7 +189,8 @@ def analysis_view(analysis: an.Analysis, report: Mapping[str, Any]) -> AnalysisV
                 INTERVAL_PANELS,
                 [metrics.get(p.name) or {} for p in parts],
                 [p.intervals for p in parts],
-            )
+            ),
+            SVG,
         )
     bootstrap = (
         f"{100 * boot.CONFIDENCE:.0f} % intervals: circular block bootstrap over frames, "
@@ -213,7 +217,8 @@ def analysis_view(analysis: an.Analysis, report: Mapping[str, Any]) -> AnalysisV
                     [gap.label for gap in part.gaps],
                     [gap.gaps for gap in part.gaps],
                     [gap.recovered for gap in part.gaps],
-                )
+                ),
+                SVG,
             )
     person_rows = tuple(
         (

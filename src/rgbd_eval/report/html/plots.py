@@ -11,6 +11,7 @@ import numpy as np
 from rgbd_eval.report.html.events import FrameErrors, Marker, MarkerKind
 from rgbd_eval.report.html.overlay import track_colour
 from rgbd_eval.report.html.render import figure_png, pyplot
+from rgbd_eval.report.html.svg import nice_step
 from rgbd_eval.types import GroundTruthObject, TrackOutput
 
 DPI = 100
@@ -119,17 +120,6 @@ _TL_LEFT, _TL_RIGHT, _TL_TOP, _TL_BOTTOM = 56, 120, 12, 44
 _FP, _FN, _SWITCH = "#9467bd", "#ff7f0e", "#ff0000"
 
 
-def _nice_step(span: float, ticks: int) -> float:
-    """A step of 1, 2 or 5 times a power of ten giving at most ``ticks`` ticks over ``span``."""
-    step = 1.0
-    while span / step > ticks:
-        for k in (2.0, 2.5, 5.0, 10.0):
-            if span / (step * k) <= ticks or k == 10.0:
-                step *= k
-                break
-    return step
-
-
 def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> bytes:
     """SVG of FP and FN per frame (steps), id switches (red ticks), the worst frames marked on
     top (black triangles).
@@ -155,7 +145,7 @@ def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> bytes:
         f'<rect width="{_TL_W}" height="{_TL_H}" fill="white"/>',
     ]
     # grid and ticks
-    step = _nice_step(x1 - x0, 10)
+    step = max(1.0, nice_step(x1 - x0, 10))
     tick = 0.0
     while tick <= x1:
         out.append(
@@ -164,7 +154,7 @@ def timeline(errors: Sequence[FrameErrors], worst: Sequence[int]) -> bytes:
             f'text-anchor="middle">{tick:g}</text>'
         )
         tick += step
-    ystep = max(1.0, _nice_step(y1, 6))
+    ystep = max(1.0, nice_step(y1, 6))
     tick = 0.0
     while tick <= y1:
         out.append(
