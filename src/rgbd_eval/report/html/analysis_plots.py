@@ -1,8 +1,8 @@
 """The plots of the analysis on ``report.html``: intervals, breakdowns, gaps, threshold curve.
 
-Each returns SVG bytes, written as text with :mod:`rgbd_eval.report.html.svg` (matplotlib
-took about 1 s of CPU for these on ``score`` over MOTChallenge's training set, most of the
-page's time). Missing values (None) are left out: no point, or a bar of zero height.
+Each returns SVG bytes, written as text with :mod:`rgbd_eval.report.html.svg` (no
+matplotlib: see there). Missing values (None) are left out: no point, or a bar of zero
+height.
 """
 
 from __future__ import annotations
