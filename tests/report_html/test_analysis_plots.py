@@ -83,6 +83,16 @@ def test_interval_plot_leaves_out_missing_values_and_escapes_names() -> None:
     assert "a<b>&c" in [t.text for t in svg.iter(f"{NS}text")]
 
 
+def test_a_long_legend_fits_on_the_interval_plot() -> None:
+    names = [f"MOT17-{k:02d}-FRCNN" for k in range(21)] + ["overall"]
+    values = [{"mota": 0.5 + k / 100} for k in range(22)]
+    svg = _svg(ap.interval_panels(names, [("mota", "MOTA")], values, [{}] * 22))
+    # 22 legend lines of 15 px from y 10: the canvas grows from 270 to 20 + 22 * 15 = 350 px.
+    assert svg.get("height") == "350"
+    last = [t for t in svg.iter(f"{NS}text") if t.text == "overall"][-1]
+    assert float(last.get("y") or 0) < 350
+
+
 def test_breakdown_bars_and_the_fp_free_panel() -> None:
     rows: list[Row] = [
         (

@@ -16,6 +16,7 @@ from rgbd_eval.report.html.svg import (
     BLUE,
     CYAN,
     GREEN,
+    LEGEND_LINE,
     MUTED,
     ORANGE,
     PURPLE,
@@ -67,10 +68,12 @@ def interval_panels(
     ]
     legend_width = max(text_width(n, 9.0) for n in names) + 40 if len(names) > 1 else 0.0
     width = int(max(540.0, 117.0 * len(panels) + 135.0) + legend_width)
-    canvas = Canvas(width, 270)
+    # Tall enough for the legend: one 15 px line per sequence (MOT17-train has 21).
+    height = max(270, 20 + LEGEND_LINE * len(names)) if len(names) > 1 else 270
+    canvas = Canvas(width, height)
     y0, y1 = data_range([v for s in series for e in s for v in e])
     ax = Axes(
-        48, 10, width - 48 - 10 - legend_width, 270 - 10 - 34, -0.5, len(panels) - 0.5, y0, y1
+        48, 10, width - 48 - 10 - legend_width, height - 10 - 34, -0.5, len(panels) - 0.5, y0, y1
     )
     ax.draw_y_axis(canvas, "%")
     step = 0.8 / max(len(names), 1)

@@ -31,6 +31,8 @@ BLUE, ORANGE, GREEN, RED, PURPLE, CYAN = (TAB10[k] for k in (0, 1, 2, 3, 4, 9))
 GRID, AXIS, MUTED = "#e4e4e4", "#4d4d4d", "#666666"
 #: Rough advance of one character, as a share of the font size (sans-serif, mixed case).
 CHAR_WIDTH = 0.6
+#: The height of a legend's line at its default 9 px font: the font and 6 px (:func:`legend`).
+LEGEND_LINE = 15
 
 
 def nice_step(span: float, ticks: int) -> float:
