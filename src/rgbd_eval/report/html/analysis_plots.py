@@ -203,10 +203,7 @@ def threshold_curve(
         value = best.get(key)
         if value is not None:
             x = ax.x(float(value))
-            canvas.add(
-                f'<line x1="{x:.1f}" y1="{ax.top:.1f}" x2="{x:.1f}" y2="{ax.bottom:.1f}" '
-                f'stroke="{colour}" stroke-dasharray="1.5,2.5"/>'
-            )
+            canvas.line(x, ax.top, x, ax.bottom, colour, dash="1.5,2.5")
     for key, colour in counts.items():
         counts_ax.polyline(canvas, xs, numbers[key], colour, dashed=True, marker="square")
     positions = ticks(x0, x1, 8)

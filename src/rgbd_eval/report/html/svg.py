@@ -95,11 +95,20 @@ class Canvas:
         )
 
     def line(
-        self, x1: float, y1: float, x2: float, y2: float, colour: str, width: float = 1.0
+        self,
+        x1: float,
+        y1: float,
+        x2: float,
+        y2: float,
+        colour: str,
+        width: float = 1.0,
+        dash: str = "",
     ) -> None:
+        """A straight line; ``dash``: an SVG ``stroke-dasharray`` (e.g. ``"1.5,2.5"``)."""
+        dashes = f' stroke-dasharray="{dash}"' if dash else ""
         self.add(
             f'<line x1="{_f(x1)}" y1="{_f(y1)}" x2="{_f(x2)}" y2="{_f(y2)}" stroke="{colour}" '
-            f'stroke-width="{width:g}"/>'
+            f'stroke-width="{width:g}"{dashes}/>'
         )
 
     def svg(self) -> bytes:
