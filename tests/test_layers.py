@@ -89,6 +89,7 @@ LAYERS = [
             "rgbd_eval.cache",
             "rgbd_eval.engine",
             "rgbd_eval.sweep",
+            "rgbd_eval.recordings",
             "rgbd_eval.bench",
             "rgbd_eval.annotate",
         ],

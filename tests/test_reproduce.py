@@ -282,7 +282,6 @@ def test_seeded_recordings_reuse_the_scenarios_own_seed(
 
     monkeypatch.setattr(synth, "synthesize", fake)
     # Present counts as current here (the provenance check has its own test in tests/sim).
-    monkeypatch.setattr(experiments, "is_current", lambda p, *_a: p.exists())
     monkeypatch.setattr(synth, "is_current", lambda p, *_a: p.exists())
     own = tmp_path / "static_simple.mcap"  # static_simple.yaml has seed 1
     rendering = synth.rendering_cpu_s()

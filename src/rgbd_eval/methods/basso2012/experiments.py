@@ -17,7 +17,6 @@ detection time is a measurement beside the thesis' (other hardware), not a claim
 from __future__ import annotations
 
 import math
-import os
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -28,7 +27,6 @@ from rgbd_eval.cache import DetectionCache, detection_key
 from rgbd_eval.components import create_detector
 from rgbd_eval.config import RunConfig, build_config, load_config, load_paper
 from rgbd_eval.datasets import scenarios_dir
-from rgbd_eval.engine import map_ordered
 from rgbd_eval.errors import ConfigError, InputError, TaskError
 from rgbd_eval.files import file_digest
 from rgbd_eval.machine import machine_info
@@ -46,13 +44,8 @@ from rgbd_eval.pipeline import (
     track_sequence,
 )
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
-from rgbd_eval.sim.synth import (
-    add_rendering_cpu,
-    ensure_scenario,
-    is_current,
-    recording_path,
-    rendering_cpu_s,
-)
+from rgbd_eval.recordings import Job, ensure_recordings, render_seeded
+from rgbd_eval.sim.synth import recording_path
 from rgbd_eval.sweep import SweepParam, expand_grid, point_configs, run_sweep
 from rgbd_eval.types import GroundTruthObject, TrackOutput, TrackStatus, Visibility
 from rgbd_eval.verdicts import (
@@ -144,34 +137,18 @@ def seeded_recordings(
     """
     say = progress or (lambda _msg: None)
     out: dict[int, dict[str, Path]] = {}
-    missing: list[tuple[Path, Path, int]] = []
+    jobs: list[Job] = []
     for seed in seeds:
         out[seed] = {}
         for name, path in recordings.items():
             source = scenarios_dir() / f"{name}.yaml"
             target = recording_path(source, path.parent, seed)
-            if target != path and not is_current(target, source, seed):
-                missing.append((source, path.parent, seed))
+            if target != path:  # at the scenario's own seed: the recording given
+                jobs.append((source, path.parent, seed))
             out[seed][name] = target
-    if missing:
-        say(f"generating {len(missing)} recordings at the other scenario seeds ...")
-        if client is None:
-            for args in missing:
-                render_seeded(*args)
-        else:
-            # a worker in another process counts its rendering there: count it here too
-            for pid, seconds in map_ordered(client, render_seeded, missing):
-                if pid != os.getpid():
-                    add_rendering_cpu(seconds)
+    # looked up here, so that a test can stand in for the renderer
+    ensure_recordings(jobs, client, say, render_seeded)
     return out
-
-
-def render_seeded(scenario: Path, folder: Path, seed: int) -> tuple[int, float]:
-    """The scenario file's recording at ``seed`` in ``folder`` (a task of
-    :func:`seeded_recordings`); returns the process id and the CPU seconds it rendered."""
-    before = rendering_cpu_s()
-    ensure_scenario(scenario, folder, seed=seed)
-    return os.getpid(), rendering_cpu_s() - before
 
 
 @dataclass(frozen=True)

@@ -39,6 +39,7 @@ from rgbd_eval.machine import machine_info
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import ground_truth_file, open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
+from rgbd_eval.recordings import Job, ensure_recordings
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.types import Box2D
 from rgbd_eval.verdicts import (
@@ -76,15 +77,6 @@ def scenario_file(name: str) -> Path:
     """A scored scene's file: ``configs/scenarios/cielniak2010/<name>.yaml`` or main's."""
     own = scenarios_dir() / "cielniak2010" / f"{name}.yaml"
     return own if own.exists() else scenarios_dir() / f"{name}.yaml"
-
-
-def seeded_recording(name: str, seed: int, folder: Path | None) -> Path:
-    """The recording of scored scene ``name`` at scenario ``seed``, rendered when absent or
-    out of date (:func:`rgbd_eval.sim.synth.ensure_scenario`: ``<name>-seed<seed>.mcap`` in
-    ``folder``; default folder: the generated datasets)."""
-    from rgbd_eval.sim.synth import ensure_scenario
-
-    return ensure_scenario(scenario_file(name), folder, seed=seed)
 
 
 def _overlaps(a: Box2D, b: Box2D) -> bool:
@@ -337,7 +329,9 @@ def run_seed(
     """Every experiment of the paper file on scenario ``seed`` (tracker seed the same)."""
     names: Mapping[str, str] = paper["scenarios"]
     say(f"seed {seed}: recordings of {', '.join(names.values())} (rendered when absent)")
-    recordings = {n: seeded_recording(n, seed, folder) for n in names.values()}
+    jobs: list[Job] = [(scenario_file(n), folder, seed) for n in names.values()]
+    paths = ensure_recordings(jobs, options.client, say)
+    recordings = dict(zip(names.values(), paths, strict=True))
     max_vis = float(paper["occlusion_count"]["max_visibility"])
     occlusion: dict[str, dict[str, Any]] = {}
     for n, path in recordings.items():

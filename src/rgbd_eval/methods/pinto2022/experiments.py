@@ -25,7 +25,7 @@ import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rgbd_eval.components import create_detector, create_tracker
 from rgbd_eval.config import load_config, load_paper
@@ -37,7 +37,7 @@ from rgbd_eval.methods.pinto2022.tracker_config import Pinto2022TrackerConfig
 from rgbd_eval.metrics import Counts, summarize, total
 from rgbd_eval.pipeline import open_for, sequence_name
 from rgbd_eval.plugins import ReproduceOptions, ReproduceResult
-from rgbd_eval.sim.synth import ensure_scenario
+from rgbd_eval.recordings import Job, ensure_recordings
 from rgbd_eval.sweep import point_configs, run_sweep
 from rgbd_eval.verdicts import (
     ClaimOverSeeds,
@@ -47,6 +47,9 @@ from rgbd_eval.verdicts import (
     spreads_json,
     tally,
 )
+
+if TYPE_CHECKING:
+    from distributed import Client
 
 #: Table III's pairs, TriNet units (V-C2).
 TRINET_PAIRS = ((100, 700), (100, 1000), (300, 700), (300, 1000), (400, 600))
@@ -362,17 +365,19 @@ def frame_rate(recording: Path, frames: int = 60) -> FrameRate:
 
 
 def seeded_recordings(
-    recordings: Mapping[str, Path], seed: int, say: Callable[[str], None]
+    recordings: Mapping[str, Path],
+    seed: int,
+    say: Callable[[str], None],
+    client: Client | None = None,
 ) -> dict[str, Path]:
     """The given scenes rendered with scenario seed ``seed`` beside their recordings
     (:func:`rgbd_eval.sim.synth.ensure_scenario`: ``<scene>-seed<seed>.mcap``, rendered
-    only when absent or out of date)."""
-    return {
-        name: ensure_scenario(
-            scenarios_dir() / "pinto2022" / f"{name}.yaml", path.parent, say, seed=seed
-        )
+    only when absent or out of date; on ``client``'s workers when given)."""
+    jobs: list[Job] = [
+        (scenarios_dir() / "pinto2022" / f"{name}.yaml", path.parent, seed)
         for name, path in recordings.items()
-    }
+    ]
+    return dict(zip(recordings, ensure_recordings(jobs, client, say), strict=True))
 
 
 def measure(
@@ -481,7 +486,7 @@ def run(recordings: Mapping[str, Path], options: ReproduceOptions) -> ReproduceR
     first: dict[str, Path] = {}
     for k, seed in enumerate(seeds):
         say(f"scenario seed {seed} ({k + 1} of {len(seeds)})")
-        seeded = seeded_recordings(recordings, seed, say)
+        seeded = seeded_recordings(recordings, seed, say, options.client)
         first = first or seeded
         per_seed[seed] = measure(seeded, options, _prefixed(say, f"seed {seed}: "))
     say("frame rate: detection + tracking on one process")
