@@ -36,7 +36,6 @@ from rgbd_eval.metrics.gating import (
     measure_matrix,
     similarity_from_measure,
 )
-from rgbd_eval.metrics.iou_kernel import sequence_box_iou
 from rgbd_eval.metrics.matching import max_similarity_pairs
 from rgbd_eval.types import Box2D, GroundTruthObject, TrackOutput, TrackStatus, Visibility
 
@@ -238,12 +237,10 @@ def _split(
     distractor: Sequence[bool] | NDArray[np.bool_],
     track_ids: list[int],
     track_values: FloatArray,
-    joined_measure: FloatArray | None = None,
 ) -> FrameSelection:
     """The selection of a frame whose ids and values are checked: ``joined_values`` are the
     rows of its ground truth with the gated field (input order), ``scored_rows`` marks the
-    scored ones and ``distractor`` the ignored distractors among them; ``joined_measure``,
-    when given, is their :func:`checked_measure` against ``track_values``."""
+    scored ones and ``distractor`` the ignored distractors among them."""
     present = frozenset(track_ids)
     everyone_scored = not ignored_ids
     gt_values = joined_values if everyone_scored else joined_values[scored_rows]
@@ -252,8 +249,7 @@ def _split(
         return FrameSelection(
             gt_ids, gt_values, track_ids, track_values, measure, ignored_ids, [], present
         )
-    if joined_measure is None:
-        joined_measure = checked_measure(gating, joined_values, track_values)
+    joined_measure = checked_measure(gating, joined_values, track_values)
     if everyone_scored:
         return FrameSelection(
             gt_ids, gt_values, track_ids, track_values, joined_measure, [], [], present
@@ -353,15 +349,9 @@ def _select_sequence(
     ignored = [o.ignore or o.visibility < min_visibility for o in objects]
     is_scored = ~np.array(ignored, dtype=bool).reshape(len(objects))
     distractor = np.array([o.distractor for o in objects], dtype=bool) & ~is_scored
-    # IoU: every frame's matrix in one compiled call (the same bits as box_iou's, per frame)
-    measures: Sequence[FloatArray | None] = (
-        sequence_box_iou(gt_values, gt_counts, track_values, track_counts)
-        if iou
-        else [None] * len(gt_counts)
-    )
     out = []
     g1 = t1 = 0
-    for n_gt, n_tracks, measure in zip(gt_counts, track_counts, measures, strict=True):
+    for n_gt, n_tracks in zip(gt_counts, track_counts, strict=True):
         g0, g1, t0, t1 = g1, g1 + n_gt, t1, t1 + n_tracks
         frame_ids, frame_ignored = ids[g0:g1], ignored[g0:g1]
         if any(frame_ignored):
@@ -380,7 +370,6 @@ def _select_sequence(
                 distractor[g0:g1],
                 track_ids[t0:t1],
                 track_values[t0:t1],
-                measure,
             )
         )
     return out
