@@ -45,24 +45,22 @@ def ensure_recordings(
     process counts its rendering there, so it is counted here too), else one by one here."""
     files = [(synth.scenario_file(s), folder, seed) for s, folder, seed in jobs]
     paths = [synth.recording_path(s, folder, seed) for s, folder, seed in files]
-    missing: list[Job] = []
-    seen: set[Path] = set()
+    missing: dict[Path, Job] = {}  # by path: a recording two jobs name is rendered once
     for job, path in zip(files, paths, strict=True):
-        if path not in seen and not synth.is_current(path, job[0], job[2]):
-            missing.append(job)
-        seen.add(path)
+        if path not in missing and not synth.is_current(path, job[0], job[2]):
+            missing[path] = job
     if missing:
         if say is not None:
             where = "on the cluster's workers" if client is not None else "one by one"
             say(f"generating {len(missing)} recording(s) {where} ...")
         done = (
-            (render(*job) for job in missing)
+            (render(*job) for job in missing.values())
             if client is None
-            else map_ordered(client, render, missing)
+            else map_ordered(client, render, list(missing.values()))
         )
-        for k, (job, (pid, seconds)) in enumerate(zip(missing, done, strict=True), start=1):
+        for k, (path, (pid, seconds)) in enumerate(zip(missing, done, strict=True), start=1):
             if pid != os.getpid():
                 synth.add_rendering_cpu(seconds)
             if say is not None:
-                say(f"rendered {synth.recording_path(*job)} ({k} of {len(missing)})")
+                say(f"rendered {path} ({k} of {len(missing)})")
     return paths
