@@ -32,3 +32,42 @@ def test_people_table_rows() -> None:
     lines = TOOL._people_table(persons).splitlines()
     assert lines[2] == "| 1 | female, 1.63 m | 0/2 | 0.10 |"
     assert lines[3] == "| 2 | male, 1.71 m | 3/4 | 0.65 |"
+
+
+def test_mirrored_box() -> None:
+    # a 640-pixel image: the box 100..150 flips to 640 - 150 = 490 .. 540
+    box = TOOL.Box2D(100.0, 20.0, 50.0, 200.0)
+    assert TOOL.mirrored(box, 640) == TOOL.Box2D(490.0, 20.0, 50.0, 200.0)
+
+
+def test_variants_table_counts_found_and_changed_verdicts() -> None:
+    def row(o: int, rendered: float, sharp: float, grey: float, mirrored: float) -> dict:
+        scores = {"rendered": rendered, "sharp": sharp, "grey background": grey}
+        return {"orientation": o, "scores": {**scores, "mirrored": mirrored}}
+
+    rows = [row(0, 0.9, 0.4, 0.8, 0.6), row(0, 0.2, 0.6, 0.7, 0.1), row(90, 0.5, 0.5, 0.1, 0.49)]
+    lines = TOOL.variants_table(rows).splitlines()
+    # rendered: 0.9 and 0.5 reach 0.5 (0 deg: 1 of 2, 90 deg: 1 of 1); median of 0.2, 0.5, 0.9
+    assert lines[2].startswith("| rendered | 1/2 | - | 1/1 | -")
+    assert lines[2].endswith("| 2/3 | 0.50 | 0 |")
+    # sharp: 0.6 and 0.5 found; verdicts unlike rendered: the first (0.4) and second (0.6)
+    assert lines[3].endswith("| 2/3 | 0.50 | 2 |")
+    # grey: 0.8 and 0.7 found, 0.1 missed: the second and third verdicts changed
+    assert lines[4].endswith("| 2/3 | 0.70 | 2 |")
+    # mirrored: only 0.6; 0.49 misses the threshold where rendered's 0.5 reached it
+    assert lines[5].endswith("| 1/3 | 0.49 | 1 |")
+
+
+def test_variant_shots_keep_the_person_and_grey_the_room() -> None:
+    shot = next(TOOL.variant_shots(1, (4.0,)))
+    rendered, grey = shot.images["rendered"], shot.images["grey background"]
+    assert set(shot.images) == set(TOOL.VARIANTS)
+    kept = (grey == rendered).all(axis=-1)
+    # every pixel changed became mid-grey; the kept ones are the person (about 10k pixels of
+    # the 307k at 4 m: a 1.63 m person is about 210 by 50 pixels)
+    assert (grey[~kept] == TOOL.GREY).all()
+    assert 5_000 < kept.sum() < 20_000
+    assert (shot.images["mirrored"] == rendered[:, ::-1]).all()
+    # the sharp frame is the same scene without blur and noise: the same size, other values
+    assert shot.images["sharp"].shape == rendered.shape
+    assert (shot.images["sharp"] != rendered).any()
