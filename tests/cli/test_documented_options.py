@@ -19,7 +19,7 @@ OPTION = re.compile(r"(?<![\w-])--[a-z][a-z0-9-]+")
 FOREIGN = {"--no-deps", "--upgrade", "--strict-markers", "--nworkers", "--nthreads"}
 FOREIGN |= {"--headless", "--web-viewer", "--use-angle", "--enable-unsafe-swiftshader"}
 FOREIGN |= {"--pcd", "--ours"}  # bench/peers/speed_ratio.py, bench/score_vs_trackeval.py
-FOREIGN |= {"--people"}  # tools/realism/measure.py
+FOREIGN |= {"--people", "--sensitivity"}  # tools/realism/measure.py
 
 
 def _options() -> dict[str, set[str]]:
