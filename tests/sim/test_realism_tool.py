@@ -41,21 +41,28 @@ def test_mirrored_box() -> None:
 
 
 def test_variants_table_counts_found_and_changed_verdicts() -> None:
-    def row(o: int, rendered: float, sharp: float, grey: float, mirrored: float) -> dict:
-        scores = {"rendered": rendered, "sharp": sharp, "grey background": grey}
-        return {"orientation": o, "scores": {**scores, "mirrored": mirrored}}
+    names = ("rendered", "no blur", "no noise", "grey background", "mirrored")
 
-    rows = [row(0, 0.9, 0.4, 0.8, 0.6), row(0, 0.2, 0.6, 0.7, 0.1), row(90, 0.5, 0.5, 0.1, 0.49)]
+    def row(o: int, *scores: float) -> dict:
+        return {"orientation": o, "scores": dict(zip(names, scores, strict=True))}
+
+    rows = [
+        row(0, 0.9, 0.4, 0.9, 0.8, 0.6),
+        row(0, 0.2, 0.6, 0.1, 0.7, 0.1),
+        row(90, 0.5, 0.5, 0.5, 0.1, 0.49),
+    ]
     lines = TOOL.variants_table(rows).splitlines()
     # rendered: 0.9 and 0.5 reach 0.5 (0 deg: 1 of 2, 90 deg: 1 of 1); median of 0.2, 0.5, 0.9
     assert lines[2].startswith("| rendered | 1/2 | - | 1/1 | -")
     assert lines[2].endswith("| 2/3 | 0.50 | 0 |")
-    # sharp: 0.6 and 0.5 found; verdicts unlike rendered: the first (0.4) and second (0.6)
+    # no blur: 0.6 and 0.5 found; verdicts unlike rendered: the first (0.4) and second (0.6)
     assert lines[3].endswith("| 2/3 | 0.50 | 2 |")
+    # no noise: the same verdicts as rendered (0.9, 0.1, 0.5)
+    assert lines[4].endswith("| 2/3 | 0.50 | 0 |")
     # grey: 0.8 and 0.7 found, 0.1 missed: the second and third verdicts changed
-    assert lines[4].endswith("| 2/3 | 0.70 | 2 |")
+    assert lines[5].endswith("| 2/3 | 0.70 | 2 |")
     # mirrored: only 0.6; 0.49 misses the threshold where rendered's 0.5 reached it
-    assert lines[5].endswith("| 1/3 | 0.49 | 1 |")
+    assert lines[6].endswith("| 1/3 | 0.49 | 1 |")
 
 
 def test_variant_shots_keep_the_person_and_grey_the_room() -> None:
@@ -68,6 +75,8 @@ def test_variant_shots_keep_the_person_and_grey_the_room() -> None:
     assert (grey[~kept] == TOOL.GREY).all()
     assert 5_000 < kept.sum() < 20_000
     assert (shot.images["mirrored"] == rendered[:, ::-1]).all()
-    # the sharp frame is the same scene without blur and noise: the same size, other values
-    assert shot.images["sharp"].shape == rendered.shape
-    assert (shot.images["sharp"] != rendered).any()
+    # the same scene without the blur, or without the noise: the same size, other values
+    for variant in ("no blur", "no noise"):
+        assert shot.images[variant].shape == rendered.shape
+        assert (shot.images[variant] != rendered).any()
+    assert (shot.images["no blur"] != shot.images["no noise"]).any()

@@ -26,13 +26,13 @@ robot frames (0.96-0.998). This script reports; its numbers are not an objective
 bodies, clothes or rendering are tuned to.
 
 ``--sensitivity M ...`` asks what in a render the SSDLite reacts to. The clear, fully visible
-people at those distances are scored four ways: as rendered; rendered again without the
-camera's blur and pixel noise (``sharp``); with everything but the person (the renderer's id
-buffer) set to mid-grey (``grey background``: the room plays no part); and flipped left to
-right (``mirrored``: a detector's answer should not depend on it, so the verdicts that flip
-show how near the threshold the people sit). Per variant: found per orientation, the median
-best score, and the verdicts that differ from the rendered frame's. A diagnosis that points
-the renderer's next change at what a detector sees, not an objective either.
+people at those distances are scored five ways: as rendered; rendered again without the
+camera's blur (``no blur``) or without its pixel noise (``no noise``); with everything but
+the person (the renderer's id buffer) set to mid-grey (``grey background``: the room plays
+no part); and flipped left to right (``mirrored``: a detector's answer should not depend on
+it, so the verdicts that flip show how near the threshold the people sit). Per variant: found
+per orientation, the median best score, and the verdicts that differ from the rendered
+frame's. A diagnosis that points the renderer's next change at what a detector sees, not an objective either.
 """
 
 from __future__ import annotations
@@ -278,13 +278,13 @@ def summary(cells: dict[str, Any]) -> dict[str, Any]:
 
 # ----------------------------------------------------------------------------- sensitivity
 
-VARIANTS = ("rendered", "sharp", "grey background", "mirrored")
+VARIANTS = ("rendered", "no blur", "no noise", "grey background", "mirrored")
 GREY = 128
 
 
 @dataclass(frozen=True)
 class VariantShot:
-    """One fully visible person: cell, ground-truth box and the four images."""
+    """One fully visible person: cell, ground-truth box and the images of :data:`VARIANTS`."""
 
     distance: float
     orientation: int
@@ -299,7 +299,7 @@ def mirrored(box: Box2D, width: int) -> Box2D:
 
 
 def variant_shots(people: int, distances: tuple[float, ...]) -> Iterator[VariantShot]:
-    """Every clear, fully visible person of the grid, in its four variants."""
+    """Every clear, fully visible person of the grid, in each of :data:`VARIANTS`."""
     for d in distances:
         for o in ORIENTATIONS:
             for p in range(1, people + 1):
@@ -310,13 +310,20 @@ def variant_shots(people: int, distances: tuple[float, ...]) -> Iterator[Variant
                 gt = f.ground_truth[0]
                 if gt.box2d is None or gt.visibility < FULLY_VISIBLE:
                     continue
-                sharp_spec = {**spec, "sensor": {"rgb_blur_px": 0.0, "rgb_noise_std": 0.0}}
-                sharp = Simulator(parse_scenario(sharp_spec, "realism")).frame(index).rgb
+                again = {
+                    name: Simulator(parse_scenario({**spec, "sensor": sensor}, "realism"))
+                    .frame(index)
+                    .rgb
+                    for name, sensor in (
+                        ("no blur", {"rgb_blur_px": 0.0}),
+                        ("no noise", {"rgb_noise_std": 0.0}),
+                    )
+                }
                 person = (f.ids == gt.object_id)[..., None]
                 grey = np.where(person, f.rgb, np.uint8(GREY)).astype(np.uint8)
                 images = {
                     "rendered": f.rgb,
-                    "sharp": sharp,
+                    **again,
                     "grey background": grey,
                     "mirrored": np.ascontiguousarray(f.rgb[:, ::-1]),
                 }
@@ -390,7 +397,7 @@ def main(argv: list[str]) -> int:
         type=float,
         nargs="+",
         metavar="M",
-        help="instead: the SSDLite's verdicts at these distances rendered, sharp, on grey, mirrored",
+        help="instead: the SSDLite's verdicts at these distances, rendered and varied",
     )
     args = ap.parse_args(argv)
     if args.sensitivity:
