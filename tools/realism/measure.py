@@ -32,7 +32,8 @@ the person (the renderer's id buffer) set to mid-grey (``grey background``: the 
 no part); and flipped left to right (``mirrored``: a detector's answer should not depend on
 it, so the verdicts that flip show how near the threshold the people sit). Per variant: found
 per orientation, the median best score, and the verdicts that differ from the rendered
-frame's. A diagnosis that points the renderer's next change at what a detector sees, not an objective either.
+frame's. A diagnosis that points the renderer's next change at what a detector sees, not
+an objective either.
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ from rgbd_eval.sim.annotate import projected_extent
 from rgbd_eval.sim.motion import clothes_at
 from rgbd_eval.sim.people import look_of
 from rgbd_eval.sim.scenario import parse_scenario
-from rgbd_eval.sim.simulate import Simulator
+from rgbd_eval.sim.simulate import SimFrame, Simulator
 from rgbd_eval.types import Box2D
 
 DISTANCES = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
@@ -121,22 +122,27 @@ def scene(distance: float, orientation: int, person: int, occluded: bool) -> dic
     }
 
 
+def last_frame(spec: dict[str, Any]) -> tuple[Simulator, SimFrame]:
+    """A realism scene's simulator and its last frame: the person has walked RUN_UP and is
+    at the cell's distance, mid-stride."""
+    sim = Simulator(parse_scenario(spec, "realism"))
+    return sim, sim.frame(sim.n_frames - 1)
+
+
 def shots(people: int, distances: tuple[float, ...]) -> Iterator[Shot]:
     """Every cell's people, rendered."""
     for occluded in (False, True):
         for d in distances:
             for o in ORIENTATIONS:
                 for p in range(1, people + 1):
-                    sim = Simulator(parse_scenario(scene(d, o, p, occluded), "realism"))
-                    index = sim.n_frames - 1  # the person has walked RUN_UP: at d, mid-stride
-                    f = sim.frame(index)
+                    sim, f = last_frame(scene(d, o, p, occluded))
                     gt = f.ground_truth[0]
-                    _, mesh, _, _ = sim.people_meshes(sim.time(index))[0]
+                    _, mesh, _, _ = sim.people_meshes(f.t)[0]
                     extent = projected_extent(mesh.vertices, sim.rgb_camera, f.rgb_pose)
                     assert extent is not None
                     u0, v0, u1, v1 = extent
                     window = Box2D(u0, v0, u1 - u0, v1 - v0)
-                    look = describe(sim, sim.time(index))
+                    look = describe(sim, f.t)
                     yield Shot(d, o, occluded, p, f.rgb, gt.box2d, window, gt.visibility, look)
 
 
@@ -304,16 +310,12 @@ def variant_shots(people: int, distances: tuple[float, ...]) -> Iterator[Variant
         for o in ORIENTATIONS:
             for p in range(1, people + 1):
                 spec = scene(d, o, p, occluded=False)
-                sim = Simulator(parse_scenario(spec, "realism"))
-                index = sim.n_frames - 1
-                f = sim.frame(index)
+                _, f = last_frame(spec)
                 gt = f.ground_truth[0]
                 if gt.box2d is None or gt.visibility < FULLY_VISIBLE:
                     continue
                 again = {
-                    name: Simulator(parse_scenario({**spec, "sensor": sensor}, "realism"))
-                    .frame(index)
-                    .rgb
+                    name: last_frame({**spec, "sensor": sensor})[1].rgb
                     for name, sensor in (
                         ("no blur", {"rgb_blur_px": 0.0}),
                         ("no noise", {"rgb_noise_std": 0.0}),
@@ -359,11 +361,14 @@ def variants_table(rows: list[dict[str, Any]]) -> str:
         "|" + "---|" * (len(ORIENTATIONS) + 4),
     ]
     found = [{v: r["scores"][v] >= PUBLISHED for v in VARIANTS} for r in rows]
+    by_orientation = {
+        o: [i for i, r in enumerate(rows) if r["orientation"] == o] for o in ORIENTATIONS
+    }
     for v in VARIANTS:
-        cells = []
-        for o in ORIENTATIONS:
-            mine = [i for i, r in enumerate(rows) if r["orientation"] == o]
-            cells.append(f"{sum(found[i][v] for i in mine)}/{len(mine)}" if mine else "-")
+        cells = [
+            f"{sum(found[i][v] for i in mine)}/{len(mine)}" if mine else "-"
+            for mine in by_orientation.values()
+        ]
         total = sum(f[v] for f in found)
         median = statistics.median(r["scores"][v] for r in rows) if rows else float("nan")
         changed = sum(f[v] != f["rendered"] for f in found)
